@@ -1,0 +1,41 @@
+// Plain sampling routines shared by the CPU reference, the GPU passes and the tests: free-flight
+// distances, uniform sphere, uniform cone (the sun's disk). Each returns its pdf's ingredients
+// in closed form so the chi-square tests can check it.
+#ifndef PLUME_SHARED_SAMPLING_H
+#define PLUME_SHARED_SAMPLING_H
+
+#include "common.h"
+
+PLUME_NS_BEGIN
+
+// Exponential free flight in a medium of extinction sigma: pdf sigma * exp(-sigma t).
+// u in [0,1); 1 - u is in (0,1] so the log is finite.
+PLUME_FN float smp_exponential(float sigma, float u) { return -log(1.0f - u) / sigma; }
+
+// Uniform direction on the unit sphere; pdf 1/(4 pi).
+PLUME_FN vec3 smp_uniform_sphere(vec2 u) {
+  float z = 1.0f - 2.0f * u.x;
+  float r = sqrt(max(0.0f, 1.0f - z * z));
+  float phi = 2.0f * PLUME_PI * u.y;
+  return vec3(r * cos(phi), r * sin(phi), z);
+}
+
+// Uniform direction in the cone of half-angle acos(cosMax) around unit `axis`;
+// pdf 1 / (2 pi (1 - cosMax)). cosMax = 1 returns the axis (a delta direction).
+PLUME_FN vec3 smp_uniform_cone(vec3 axis, float cosMax, vec2 u) {
+  float cosTheta = 1.0f - u.x * (1.0f - cosMax);
+  float sinTheta = sqrt(max(0.0f, 1.0f - cosTheta * cosTheta));
+  float phi = 2.0f * PLUME_PI * u.y;
+  vec3 b1;
+  vec3 b2;
+  plume_onb(axis, b1, b2);
+  return normalize(sinTheta * cos(phi) * b1 + sinTheta * sin(phi) * b2 + cosTheta * axis);
+}
+
+PLUME_FN float smp_uniform_cone_pdf(float cosMax) {
+  return 1.0f / (2.0f * PLUME_PI * (1.0f - cosMax));
+}
+
+PLUME_NS_END
+
+#endif

@@ -1,0 +1,35 @@
+// plume: thin main. Commands live in cmd_*.cpp; errors map to exit codes (core/error.h).
+#include "app/commands.h"
+#include "core/error.h"
+
+#include <cstdio>
+
+int main(int argc, char** argv) {
+  using namespace plume;
+  CLI::App app{"Plume: volumetric ReSTIR renderer for OpenVDB smoke, clouds and fire"};
+  app.set_version_flag("--version", std::string("plume ") + PLUME_VERSION);
+  app.require_subcommand(1);
+  Action action;
+  addInfoCommand(app, action);
+  addReferenceCommand(app, action);
+  addCompareCommand(app, action);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "plume: %s\n", e.what());
+    return kExitBadInput;
+  }
+  try {
+    return action ? action() : kExitOk;
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "plume: error: %s\n", e.what());
+    return kExitBadInput;
+  } catch (const DeviceError& e) {
+    std::fprintf(stderr, "plume: device error: %s\n", e.what());
+    return kExitDeviceFailure;
+  }
+}

@@ -1,0 +1,1 @@
+#include "media/vdb_loader.h"

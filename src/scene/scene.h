@@ -1,0 +1,102 @@
+// The scene file (DESIGN §9): parsing and validation. Every error is an InputError of the form
+// "<file>: <key path>: <what is wrong>", e.g. "scene.json: media[0].albedo: expected 3 numbers
+// in [0,1]". Unknown keys are errors. Relative paths resolve against the scene file's folder.
+#pragma once
+
+#include "scene/settings.h"
+
+#include <glm/vec3.hpp>
+#include <nlohmann/json_fwd.hpp>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace plume {
+
+struct CameraPose {
+  glm::vec3 position{0, 1, 4};
+  glm::vec3 lookAt{0, 0, 0};
+  glm::vec3 up{0, 1, 0};
+  float fovY = 40.0f;  // vertical, degrees
+};
+
+struct CameraKey {
+  int frame = 1;
+  CameraPose pose;  // fields missing in the file inherit from the previous key (or the base)
+};
+
+struct Camera {
+  CameraPose base;     // acts as a key at `baseFrame`
+  int baseFrame = 1;   // the first frame of the scene file's render.frames (not CLI overrides)
+  int width = 320;
+  int height = 180;
+  std::vector<CameraKey> keys;  // sorted by frame
+
+  // Pose at `frame`, linear between keys and held constant outside them.
+  CameraPose poseAt(double frame) const;
+  bool moves() const { return !keys.empty(); }
+};
+
+struct Emission {
+  std::string grid;   // grid name in the medium's VDB
+  float scale = 1.0f;
+};
+
+struct Medium {
+  std::string vdb;                  // resolved path; may hold a {frame:04} pattern
+  std::string densityGrid = "density";
+  float densityScale = 1.0f;        // sigma_t = densityScale * d(x) per world unit
+  glm::vec3 albedo{1.0f};
+  float g = 0.0f;                   // Henyey–Greenstein, g > 0 forward
+  std::optional<Emission> emission;
+
+  bool animated() const;            // the path has a frame pattern
+  std::string vdbPath(int frame) const;
+};
+
+enum class LightType { Sun, Point, Environment };
+
+struct Light {
+  LightType type = LightType::Sun;
+  // sun
+  glm::vec3 toLight{0, 1, 0};       // normalised on load
+  glm::vec3 irradiance{0};          // W/m² perpendicular to the sun direction
+  float angularRadiusDeg = 0.0f;    // 0: a delta direction
+  // point
+  glm::vec3 position{0};
+  glm::vec3 intensity{0};           // W/sr
+  // environment
+  glm::vec3 radiance{0};            // constant radiance (multiplied by `scale`)
+  std::string map;                  // optional equirectangular EXR (resolved path)
+  float rotateYDeg = 0.0f;
+  float scale = 1.0f;
+};
+
+struct Surface {
+  std::string obj;  // resolved path
+  glm::vec3 albedo{0.5f};
+};
+
+struct Scene {
+  std::string path;  // the scene file, as given
+  std::string dir;   // its folder
+  Camera camera;
+  std::vector<Medium> media;
+  std::vector<Light> lights;
+  std::vector<Surface> surfaces;
+  RenderSettings render;
+
+  bool hasEnvironment() const;
+};
+
+// Reads and validates a scene file. Throws InputError.
+Scene loadScene(const std::string& path);
+// Validates an already parsed document; `path` is used in messages, `dir` to resolve files.
+Scene parseScene(const nlohmann::json& doc, const std::string& path, const std::string& dir);
+
+// "{frame:04}" (any width) replaced by the frame number; other text unchanged.
+std::string expandFramePattern(const std::string& pattern, int frame);
+bool hasFramePattern(const std::string& pattern);
+
+}  // namespace plume

@@ -1,0 +1,113 @@
+#include "scene/settings.h"
+
+#include "core/error.h"
+#include "core/log.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <limits>
+
+namespace plume {
+
+const std::vector<SettingDesc>& renderSettingsTable() {
+  static const std::vector<SettingDesc> table = {
+      {"mode", "estimator: pt (delta-tracking path tracer), restir (unbiased), restir-biased",
+       &RenderSettings::mode, 0, 0, {"pt", "restir", "restir-biased"}},
+      {"max_bounces", "largest number of scattering events on a path (1 = single scattering)",
+       &RenderSettings::maxBounces, 0, 100000, {}},
+      {"spp", "samples per pixel per frame", &RenderSettings::spp, 1, 1 << 24, {}},
+      {"seed", "random seed (0 .. 2^32-1); same seed and device give the same image",
+       &RenderSettings::seed, 0, 4294967295.0, {}},
+      {"rr_start_bounce", "first bounce at which Russian roulette may end a path",
+       &RenderSettings::rrStartBounce, 1, 100000, {}},
+  };
+  return table;
+}
+
+std::string cliFlagFor(const std::string& key) {
+  std::string flag = "--" + key;
+  for (char& c : flag) c = c == '_' ? '-' : c;
+  return flag;
+}
+
+namespace {
+
+[[noreturn]] void bad(const std::string& where, const std::string& keyPath, const std::string& what) {
+  throw InputError(where + ": " + keyPath + ": " + what);
+}
+
+int64_t integerIn(const nlohmann::json& v, double lo, double hi, const std::string& where,
+                  const std::string& keyPath) {
+  auto rangeText = [&] { return strf("expected an integer in [%.0f, %.0f]", lo, hi); };
+  if (!v.is_number()) bad(where, keyPath, rangeText());
+  double d = v.get<double>();
+  if (!std::isfinite(d) || d != std::floor(d) || d < lo || d > hi) bad(where, keyPath, rangeText());
+  return int64_t(d);
+}
+
+}  // namespace
+
+bool applyRenderSetting(RenderSettings& s, const std::string& key, const nlohmann::json& value,
+                        const std::string& where, const std::string& keyPath) {
+  if (key == "frames") {
+    const double lim = 1e7;
+    if (value.is_number()) {
+      s.frameFirst = s.frameLast = int(integerIn(value, -lim, lim, where, keyPath));
+    } else if (value.is_array() && value.size() == 2) {
+      int a = int(integerIn(value[0], -lim, lim, where, keyPath));
+      int b = int(integerIn(value[1], -lim, lim, where, keyPath));
+      if (b < a) bad(where, keyPath, "expected [first, last] with first <= last");
+      s.frameFirst = a;
+      s.frameLast = b;
+    } else {
+      bad(where, keyPath, "expected [first, last] frame numbers");
+    }
+    return true;
+  }
+  for (const SettingDesc& d : renderSettingsTable()) {
+    if (key != d.key) continue;
+    if (auto* m = std::get_if<int RenderSettings::*>(&d.member)) {
+      s.*(*m) = int(integerIn(value, d.min, d.max, where, keyPath));
+    } else if (auto* m64 = std::get_if<int64_t RenderSettings::*>(&d.member)) {
+      s.*(*m64) = integerIn(value, d.min, d.max, where, keyPath);
+    } else if (auto* ms = std::get_if<std::string RenderSettings::*>(&d.member)) {
+      if (!value.is_string()) bad(where, keyPath, "expected a string");
+      std::string text = value.get<std::string>();
+      if (!d.choices.empty()) {
+        bool ok = false;
+        std::string list;
+        for (const auto& c : d.choices) {
+          ok = ok || c == text;
+          list += (list.empty() ? "" : ", ") + c;
+        }
+        if (!ok) bad(where, keyPath, "expected one of " + list + " (got \"" + text + "\")");
+      }
+      s.*(*ms) = text;
+    }
+    return true;
+  }
+  return false;
+}
+
+bool applyRenderSettingText(RenderSettings& s, const std::string& key, const std::string& text) {
+  nlohmann::json value;
+  if (key == "frames") {
+    auto dash = text.find('-', 1);
+    try {
+      if (dash == std::string::npos) {
+        value = std::stoll(text);
+      } else {
+        value = nlohmann::json::array({std::stoll(text.substr(0, dash)), std::stoll(text.substr(dash + 1))});
+      }
+    } catch (const std::exception&) {
+      throw InputError("command line: --frames: expected FIRST-LAST or a frame number (got \"" + text + "\")");
+    }
+  } else {
+    value = nlohmann::json::parse(text, nullptr, false);
+    if (value.is_discarded() || value.is_object() || value.is_array()) value = text;  // plain string
+  }
+  return applyRenderSetting(s, key, value, "command line", cliFlagFor(key));
+}
+
+}  // namespace plume

@@ -1,0 +1,46 @@
+// Render settings, declared once: a table that gives every setting's JSON key (under "render"),
+// command-line flag, default, valid range and help. The scene parser, the CLI and (later) the
+// viewer and tests all read and write settings through this table.
+#pragma once
+
+#include <nlohmann/json_fwd.hpp>
+
+#include <cstdint>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace plume {
+
+struct RenderSettings {
+  std::string mode = "pt";   // pt | restir | restir-biased
+  int maxBounces = 8;        // largest number of scattering events on a path (1 = single)
+  int spp = 4;               // samples per pixel per frame
+  int64_t seed = 1;          // 0 .. 2^32-1
+  int frameFirst = 1;        // render.frames = [first, last]
+  int frameLast = 1;
+  int rrStartBounce = 3;     // Russian roulette from this bounce on (unbiased)
+};
+
+struct SettingDesc {
+  using Member = std::variant<int RenderSettings::*, int64_t RenderSettings::*,
+                              std::string RenderSettings::*>;
+  const char* key;    // JSON key under "render" and CLI flag (--key, '_' -> '-')
+  const char* help;
+  Member member;
+  double min = 0, max = 0;              // numeric range (inclusive)
+  std::vector<std::string> choices;     // for strings; empty = any
+};
+
+const std::vector<SettingDesc>& renderSettingsTable();
+
+// Sets `key` from a JSON value; throws InputError "<where>: <keyPath>: ..." on a bad value.
+// "frames" takes [first, last] (or a single number). Returns false for an unknown key.
+bool applyRenderSetting(RenderSettings& s, const std::string& key, const nlohmann::json& value,
+                        const std::string& where, const std::string& keyPath);
+// Same, from command-line text ("16", "restir", "1-48" for frames).
+bool applyRenderSettingText(RenderSettings& s, const std::string& key, const std::string& text);
+
+std::string cliFlagFor(const std::string& key);  // "max_bounces" -> "--max-bounces"
+
+}  // namespace plume

@@ -1,0 +1,48 @@
+#include "support/test_support.h"
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <sys/wait.h>
+
+namespace plume::test {
+namespace fs = std::filesystem;
+
+std::string sourcePath(const std::string& rel) { return (fs::path(PLUME_SOURCE_DIR) / rel).string(); }
+
+std::string sharedVolumesPath() {
+  fs::path p = fs::path(PLUME_SOURCE_DIR) / ".." / "shared" / "volumes" / "blender-mantaflow";
+  return fs::is_directory(p) ? fs::canonical(p).string() : std::string();
+}
+
+std::string outputDir(const std::string& name) {
+  fs::path p = fs::path(PLUME_BINARY_DIR) / "test-output" / name;
+  fs::remove_all(p);
+  fs::create_directories(p);
+  return p.string();
+}
+
+namespace {
+std::string shellQuote(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+}  // namespace
+
+RunResult runPlume(const std::vector<std::string>& args) {
+  std::string cmd = shellQuote(PLUME_EXE);
+  for (const auto& a : args) cmd += " " + shellQuote(a);
+  cmd += " 2>&1";
+  RunResult result;
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) return result;
+  std::array<char, 4096> buf;
+  size_t n;
+  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) result.output.append(buf.data(), n);
+  int status = pclose(pipe);
+  result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+}  // namespace plume::test

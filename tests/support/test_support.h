@@ -1,0 +1,21 @@
+// Helpers shared by the test executables: paths, running the plume binary, temp folders.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace plume::test {
+
+std::string sourcePath(const std::string& rel);  // PLUME_SOURCE_DIR / rel
+std::string sharedVolumesPath();                 // ../shared/volumes/blender-mantaflow, or "" if absent
+// A fresh folder under build/test-output/<name>/ (emptied first); failing tests write files here.
+std::string outputDir(const std::string& name);
+
+struct RunResult {
+  int exitCode = -1;
+  std::string output;  // stdout and stderr together
+};
+// Runs `plume` with the arguments (shell-quoted for you).
+RunResult runPlume(const std::vector<std::string>& args);
+
+}  // namespace plume::test

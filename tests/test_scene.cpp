@@ -1,0 +1,97 @@
+#include "core/error.h"
+#include "scene/scene.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+using namespace plume;
+using nlohmann::json;
+
+namespace {
+
+json minimalScene() {
+  return json::parse(R"({
+    "camera": {"position": [0, 1, 4], "look_at": [0, 0.5, 0], "fov_y": 40, "width": 64, "height": 32},
+    "media": [{"vdb": "smoke/smoke_{frame:04}.vdb", "density_scale": 8, "albedo": [0.9, 0.9, 0.9], "g": 0.3}],
+    "lights": [{"type": "sun", "to_light": [0, 2, 0], "irradiance": [3, 3, 3]}],
+    "render": {"max_bounces": 4, "spp": 8, "seed": 7, "frames": [1, 24]}
+  })");
+}
+
+std::string errorOf(const json& doc) {
+  try {
+    parseScene(doc, "scene.json", "/nonexistent");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(Scene, ParsesTheDesignExampleKeys) {
+  Scene s = parseScene(minimalScene(), "scene.json", "/data");
+  EXPECT_EQ(s.camera.width, 64);
+  EXPECT_EQ(s.media.at(0).vdb, "/data/smoke/smoke_{frame:04}.vdb");
+  EXPECT_EQ(s.media[0].vdbPath(7), "/data/smoke/smoke_0007.vdb");
+  EXPECT_FLOAT_EQ(s.lights.at(0).toLight.y, 1.0f);  // normalised
+  EXPECT_EQ(s.render.maxBounces, 4);
+  EXPECT_EQ(s.render.frameLast, 24);
+  EXPECT_EQ(s.render.mode, "pt");  // default
+}
+
+TEST(Scene, ErrorsNameTheKeyPath) {
+  json d = minimalScene();
+  d["media"][0]["albedo"] = {0.5, 2.0, 0.5};
+  EXPECT_EQ(errorOf(d), "scene.json: media[0].albedo: expected 3 numbers in [0,1]");
+  d = minimalScene();
+  d["media"][0]["g"] = 1.0;
+  EXPECT_NE(errorOf(d).find("media[0].g"), std::string::npos);
+  d = minimalScene();
+  d["media"][0]["density_scale"] = -1;
+  EXPECT_NE(errorOf(d).find("media[0].density_scale"), std::string::npos);
+  d = minimalScene();
+  d["lights"][0]["to_light"] = {0, 0, 0};
+  EXPECT_EQ(errorOf(d), "scene.json: lights[0].to_light: zero-length direction");
+  d = minimalScene();
+  d["camera"]["colour"] = 1;
+  EXPECT_EQ(errorOf(d), "scene.json: camera.colour: unknown key");
+  d = minimalScene();
+  d["render"]["spp"] = "many";
+  EXPECT_NE(errorOf(d).find("render.spp"), std::string::npos);
+  d = minimalScene();
+  d["render"]["mode"] = "magic";
+  EXPECT_NE(errorOf(d).find("render.mode: expected one of pt, restir, restir-biased"), std::string::npos);
+  d = minimalScene();
+  d["camera"]["look_at"] = {0, 1, 4};
+  EXPECT_NE(errorOf(d).find("camera.look_at"), std::string::npos);
+}
+
+TEST(Scene, CameraKeysInterpolateAndHold) {
+  json d = minimalScene();
+  d["camera"]["keys"] = json::array({{{"frame", 11}, {"position", {2, 1, 4}}}});
+  Scene s = parseScene(d, "scene.json", "/data");
+  EXPECT_FLOAT_EQ(s.camera.poseAt(1).position.x, 0.0f);
+  EXPECT_FLOAT_EQ(s.camera.poseAt(6).position.x, 1.0f);
+  EXPECT_FLOAT_EQ(s.camera.poseAt(30).position.x, 2.0f);
+  EXPECT_FLOAT_EQ(s.camera.poseAt(6).lookAt.y, 0.5f);  // inherited from the base pose
+}
+
+TEST(Scene, CommandLineOverridesGoThroughTheSettingsTable) {
+  RenderSettings r;
+  EXPECT_TRUE(applyRenderSettingText(r, "spp", "64"));
+  EXPECT_EQ(r.spp, 64);
+  EXPECT_TRUE(applyRenderSettingText(r, "frames", "3-9"));
+  EXPECT_EQ(r.frameFirst, 3);
+  EXPECT_EQ(r.frameLast, 9);
+  EXPECT_TRUE(applyRenderSettingText(r, "mode", "restir"));
+  EXPECT_EQ(r.mode, "restir");
+  EXPECT_THROW(applyRenderSettingText(r, "spp", "0"), InputError);
+  EXPECT_FALSE(applyRenderSettingText(r, "nonsense", "1"));
+}
+
+TEST(Scene, FramePatterns) {
+  EXPECT_EQ(expandFramePattern("a_{frame:04}.vdb", 12), "a_0012.vdb");
+  EXPECT_EQ(expandFramePattern("a_{frame}.vdb", 12), "a_12.vdb");
+  EXPECT_FALSE(hasFramePattern("plain.vdb"));
+}
