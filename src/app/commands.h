@@ -12,5 +12,6 @@ using Action = std::function<int()>;
 void addInfoCommand(CLI::App& app, Action& action);       // cmd_info.cpp
 void addCompareCommand(CLI::App& app, Action& action);    // cmd_compare.cpp
 void addReferenceCommand(CLI::App& app, Action& action);  // cmd_reference.cpp
+void addRenderCommand(CLI::App& app, Action& action);     // cmd_render.cpp
 
 }  // namespace plume

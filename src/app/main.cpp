@@ -11,6 +11,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   Action action;
   addInfoCommand(app, action);
+  addRenderCommand(app, action);
   addReferenceCommand(app, action);
   addCompareCommand(app, action);
   try {

@@ -43,4 +43,10 @@ std::vector<GridSummary> inspectVdb(const std::string& path);
 // a non-zero background.
 LoadedGrid loadFloatGrid(const std::string& path, const std::string& gridName);
 
+// The sanitising step of loadFloatGrid, for grids built in code (tests, tools): active values
+// (voxels and tiles) that are NaN, Inf or negative become 0, every inactive value becomes the
+// background 0 (so that samplers reading inactive voxels see 0, DESIGN §2). Returns the number of
+// replaced active *voxels* (a replaced tile counts as the voxels it covers). Parallel.
+uint64_t sanitizeGrid(openvdb::FloatGrid& grid);
+
 }  // namespace plume

@@ -1,1 +1,276 @@
-// The CPU reference (filled in next).
+#include "reference/reference.h"
+
+#include "core/error.h"
+#include "core/log.h"
+#include "core/progress.h"
+#include "reference/medium.h"
+#include "shaders/shared/phase.h"
+#include "shaders/shared/sampling.h"
+
+#include <glm/geometric.hpp>
+#include <glm/glm.hpp>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+#include <cmath>
+#include <vector>
+
+namespace plume::ref {
+namespace {
+
+using glm::dvec3;
+namespace sh = plume::shared;
+
+// A light prepared for sampling: everything derived once per render.
+struct PreparedLight {
+  LightType type;
+  dvec3 dir{0};         // sun: unit vector towards the sun
+  double cosMax = 1.0;  // sun: cone of the disk; 1 = delta direction
+  dvec3 radiance{0};    // sun with a disk: L = E / (pi sin^2 alpha); environment: L
+  dvec3 irradiance{0};  // delta sun
+  dvec3 position{0};    // point
+  dvec3 intensity{0};   // point
+};
+
+struct Context {
+  const ReferenceMedium* medium;
+  std::vector<PreparedLight> lights;
+  dvec3 albedo;
+  float g;
+  int maxBounces;
+  int rrStartBounce;
+  dvec3 environment{0};  // sum of constant environment radiance seen by escaping camera rays
+  TrackingStats* tracking;
+};
+
+dvec3 toD(glm::vec3 v) { return dvec3(v); }
+
+std::vector<PreparedLight> prepareLights(const Scene& scene) {
+  std::vector<PreparedLight> out;
+  for (const Light& l : scene.lights) {
+    PreparedLight p;
+    p.type = l.type;
+    switch (l.type) {
+      case LightType::Sun: {
+        p.dir = glm::normalize(toD(l.toLight));
+        double alpha = glm::radians(double(l.angularRadiusDeg));
+        if (alpha > 0) {
+          p.cosMax = std::cos(alpha);
+          double sin2 = std::sin(alpha) * std::sin(alpha);
+          p.radiance = toD(l.irradiance) / (M_PI * sin2);
+        } else {
+          p.irradiance = toD(l.irradiance);
+        }
+        break;
+      }
+      case LightType::Point:
+        p.position = toD(l.position);
+        p.intensity = toD(l.intensity);
+        break;
+      case LightType::Environment:
+        p.radiance = toD(l.radiance) * double(l.scale);
+        break;
+    }
+    out.push_back(p);
+  }
+  return out;
+}
+
+double phase(double cosTheta, float g) { return sh::ph_hg(float(cosTheta), g); }
+
+// Next-event estimation at a real collision x; `rayDir` is the path's propagation direction
+// (from the camera outwards). Light arriving from direction w (travelling along -w) scatters
+// towards the camera (along -rayDir): cosTheta = dot(-w, -rayDir) = dot(w, rayDir).
+dvec3 estimateDirect(const Context& c, const dvec3& x, const dvec3& rayDir, Pcg32& rng,
+                     const ReferenceMedium::Accessor& acc) {
+  dvec3 sum(0);
+  const double inf = std::numeric_limits<double>::infinity();
+  for (const PreparedLight& l : c.lights) {
+    switch (l.type) {
+      case LightType::Sun: {
+        if (l.cosMax >= 1.0) {
+          double tr = c.medium->ratioTracking({x, l.dir}, inf, rng, acc, *c.tracking);
+          sum += l.irradiance * phase(glm::dot(l.dir, rayDir), c.g) * tr;
+        } else {
+          glm::vec2 u(rng.uniform(), rng.uniform());
+          dvec3 w = dvec3(sh::smp_uniform_cone(glm::vec3(l.dir), float(l.cosMax), u));
+          double tr = c.medium->ratioTracking({x, w}, inf, rng, acc, *c.tracking);
+          double pdf = 1.0 / (2.0 * M_PI * (1.0 - l.cosMax));
+          sum += l.radiance * phase(glm::dot(w, rayDir), c.g) * tr / pdf;
+        }
+        break;
+      }
+      case LightType::Point: {
+        dvec3 toL = l.position - x;
+        double dist = glm::length(toL);
+        if (dist <= 0) break;
+        dvec3 w = toL / dist;
+        double tr = c.medium->ratioTracking({x, w}, dist, rng, acc, *c.tracking);
+        sum += l.intensity / (dist * dist) * phase(glm::dot(w, rayDir), c.g) * tr;
+        break;
+      }
+      case LightType::Environment: {
+        // Importance sample the phase function: weight = L * phase / pdf * T = L * T.
+        glm::vec2 u(rng.uniform(), rng.uniform());
+        dvec3 w = dvec3(sh::ph_hg_sample(glm::vec3(rayDir), c.g, u));
+        double tr = c.medium->ratioTracking({x, w}, inf, rng, acc, *c.tracking);
+        sum += l.radiance * tr;
+        break;
+      }
+    }
+  }
+  return sum;
+}
+
+// One camera path. Emission and surfaces are refused earlier (checkReferenceSupports).
+dvec3 tracePath(const Context& c, Ray ray, Pcg32& rng, const ReferenceMedium::Accessor& acc) {
+  dvec3 radiance(0), beta(1);
+  const double inf = std::numeric_limits<double>::infinity();
+  for (int scatterings = 0;; ) {
+    double t;
+    if (!c.medium->sampleCollision(ray, inf, rng, acc, t, *c.tracking)) {
+      // Escaped. Light sources are reached by next-event estimation after the first vertex,
+      // so only camera rays add the environment seen directly.
+      if (scatterings == 0) radiance += beta * c.environment;
+      break;
+    }
+    if (++scatterings > c.maxBounces) break;
+    const dvec3 x = ray.origin + t * ray.direction;
+    beta *= c.albedo;  // a real collision scatters with probability albedo: weight instead
+    radiance += beta * estimateDirect(c, x, ray.direction, rng, acc);
+    if (scatterings >= c.rrStartBounce) {
+      double q = std::min(1.0, std::max({beta.x, beta.y, beta.z}));
+      if (double(rng.uniform()) >= q) break;
+      beta /= q;
+    }
+    glm::vec2 u(rng.uniform(), rng.uniform());
+    ray = {x, glm::normalize(dvec3(sh::ph_hg_sample(glm::vec3(ray.direction), c.g, u)))};
+  }
+  return radiance;
+}
+
+struct CameraFrame {
+  dvec3 position, forward, right, up;
+  double tanHalfY, aspect;
+};
+
+CameraFrame cameraFrame(const Camera& cam, int frame) {
+  CameraPose pose = cam.poseAt(frame);
+  CameraFrame f;
+  f.position = toD(pose.position);
+  f.forward = glm::normalize(toD(pose.lookAt - pose.position));
+  f.right = glm::normalize(glm::cross(f.forward, toD(pose.up)));  // DESIGN §2: right-handed
+  f.up = glm::cross(f.right, f.forward);
+  f.tanHalfY = std::tan(glm::radians(double(pose.fovY)) * 0.5);
+  f.aspect = double(cam.width) / cam.height;
+  return f;
+}
+
+// Box filter: a uniform point in the pixel's square; row 0 at the top.
+Ray cameraRay(const CameraFrame& f, const Camera& cam, int px, int py, double u, double v) {
+  double sx = (2.0 * (px + u) / cam.width - 1.0) * f.tanHalfY * f.aspect;
+  double sy = (1.0 - 2.0 * (py + v) / cam.height) * f.tanHalfY;
+  return {f.position, glm::normalize(f.forward + sx * f.right + sy * f.up)};
+}
+
+}  // namespace
+
+void checkReferenceSupports(const Scene& scene) {
+  if (!scene.surfaces.empty()) {
+    throw InputError(scene.path + ": surfaces: not supported by the CPU reference yet");
+  }
+  for (size_t i = 0; i < scene.media.size(); ++i) {
+    if (scene.media[i].emission) {
+      throw InputError(scene.path + strf(": media[%zu].emission: not supported by the CPU reference yet", i));
+    }
+  }
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    if (!scene.lights[i].map.empty()) {
+      throw InputError(scene.path + strf(": lights[%zu].map: environment maps are not supported by the CPU reference yet", i));
+    }
+  }
+}
+
+Image renderReference(const Scene& scene, openvdb::FloatGrid::ConstPtr density,
+                      const ReferenceOptions& options, ReferenceStats* statsOut) {
+  checkReferenceSupports(scene);
+  const Medium& m = scene.media.at(0);
+  const RenderSettings& rs = scene.render;
+  const Camera& cam = scene.camera;
+  ReferenceMedium medium(density, m.densityScale);
+  TrackingStats tracking;
+
+  Context ctx;
+  ctx.medium = &medium;
+  ctx.lights = prepareLights(scene);
+  ctx.albedo = toD(m.albedo);
+  ctx.g = m.g;
+  ctx.maxBounces = rs.maxBounces;
+  ctx.rrStartBounce = rs.rrStartBounce;
+  ctx.tracking = &tracking;
+  for (const PreparedLight& l : ctx.lights) {
+    if (l.type == LightType::Environment) ctx.environment += l.radiance;
+  }
+
+  const CameraFrame frame = cameraFrame(cam, options.frame);
+  const int ts = options.tileSize;
+  const int tilesX = (cam.width + ts - 1) / ts, tilesY = (cam.height + ts - 1) / ts;
+  Image image(cam.width, cam.height, true);
+  const uint64_t frameSeed = mix64(uint64_t(uint32_t(rs.seed)) ^ mix64(uint64_t(int64_t(options.frame))));
+  std::unique_ptr<ProgressBar> bar;
+  if (options.progress) bar = std::make_unique<ProgressBar>(strf("reference frame %d", options.frame), uint64_t(tilesX) * tilesY);
+
+  const auto start = std::chrono::steady_clock::now();
+  tbb::parallel_for(tbb::blocked_range<int>(0, tilesX * tilesY, 1), [&](const tbb::blocked_range<int>& r) {
+    ReferenceMedium::Accessor acc = medium.accessor();
+    for (int tile = r.begin(); tile != r.end(); ++tile) {
+      const int x0 = (tile % tilesX) * ts, y0 = (tile / tilesX) * ts;
+      for (int py = y0; py < std::min(y0 + ts, cam.height); ++py) {
+        for (int px = x0; px < std::min(x0 + ts, cam.width); ++px) {
+          Pcg32 rng(frameSeed, uint64_t(py) * uint64_t(cam.width) + uint64_t(px));
+          dvec3 sum(0), sumSq(0);
+          for (int s = 0; s < rs.spp; ++s) {
+            double u = rng.uniform(), v = rng.uniform();
+            dvec3 L = tracePath(ctx, cameraRay(frame, cam, px, py, u, v), rng, acc);
+            sum += L;
+            sumSq += L * L;
+          }
+          const double n = rs.spp;
+          dvec3 mean = sum / n;
+          dvec3 varMean = n > 1 ? glm::max(dvec3(0), (sumSq - n * mean * mean) / (n * (n - 1))) : dvec3(0);
+          image.setPixel(px, py, glm::vec3(mean));
+          image.setVariance(px, py, glm::vec3(varMean));
+        }
+      }
+      if (bar) bar->advance();
+    }
+  });
+  if (bar) bar->finish();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  ReferenceStats stats;
+  stats.seconds = seconds;
+  stats.samples = uint64_t(cam.width) * cam.height * rs.spp;
+  stats.truncatedTracking = tracking.truncated.load();
+  stats.trackingSteps = tracking.steps.load();
+  if (stats.truncatedTracking > 0) {
+    logWarn(strf("frame %d: %llu tracking loops hit the step cap (%llu steps) and were truncated",
+                 options.frame, (unsigned long long)stats.truncatedTracking,
+                 (unsigned long long)ReferenceMedium::kMaxTrackingSteps));
+  }
+  image.meta["version"] = PLUME_VERSION;
+  image.meta["mode"] = "reference";
+  image.meta["spp"] = std::to_string(rs.spp);
+  image.meta["seed"] = std::to_string(rs.seed);
+  image.meta["frame"] = std::to_string(options.frame);
+  image.meta["max_bounces"] = std::to_string(rs.maxBounces);
+  image.meta["wall_time_s"] = strf("%.3f", seconds);
+  image.meta["samples_per_s"] = strf("%.0f", stats.samplesPerSecond());
+  image.meta["tracking_truncated"] = std::to_string(stats.truncatedTracking);
+  image.meta["device"] = "cpu-reference";
+  if (statsOut) *statsOut = stats;
+  return image;
+}
+
+}  // namespace plume::ref

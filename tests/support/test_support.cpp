@@ -1,9 +1,12 @@
 #include "support/test_support.h"
 
+#include <gtest/gtest.h>
+
 #include <array>
 #include <cstdio>
 #include <filesystem>
 #include <sys/wait.h>
+#include <unistd.h>
 
 namespace plume::test {
 namespace fs = std::filesystem;
@@ -16,7 +19,13 @@ std::string sharedVolumesPath() {
 }
 
 std::string outputDir(const std::string& name) {
+  // ctest runs tests in parallel processes: each test gets its own folder under `name`.
   fs::path p = fs::path(PLUME_BINARY_DIR) / "test-output" / name;
+  if (const auto* info = ::testing::UnitTest::GetInstance()->current_test_info()) {
+    p /= std::string(info->test_suite_name()) + "." + info->name();
+  } else {
+    p /= "process" + std::to_string(getpid());  // suite set-up: one folder per process
+  }
   fs::remove_all(p);
   fs::create_directories(p);
   return p.string();

@@ -8,7 +8,7 @@ namespace plume::test {
 
 std::string sourcePath(const std::string& rel);  // PLUME_SOURCE_DIR / rel
 std::string sharedVolumesPath();                 // ../shared/volumes/blender-mantaflow, or "" if absent
-// A fresh folder under build/test-output/<name>/ (emptied first); failing tests write files here.
+// A fresh folder build/test-output/<name>/<Suite.Test>/ (emptied first); failing tests write files here.
 std::string outputDir(const std::string& name);
 
 struct RunResult {

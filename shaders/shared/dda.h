@@ -1,0 +1,82 @@
+// A 3D DDA over a grid of cubic cells (Amanatides & Woo 1987), as a small state machine so the
+// caller decides what to do per cell (pbrt-v4's majorant iterator in the same spirit). The ray
+// is o + t d in the grid's space; t keeps the caller's units (world units for Plume: d is the
+// world direction mapped to index space, not normalised).
+#ifndef PLUME_SHARED_DDA_H
+#define PLUME_SHARED_DDA_H
+
+#include "common.h"
+
+PLUME_NS_BEGIN
+
+const float DDA_INF = 3.0e38f;
+
+struct DdaState {
+  float t;       // start of the next segment
+  float tEnd;    // end of the ray inside the grid
+  ivec3 cell;
+  ivec3 stepDir;
+  vec3 tNext;    // t at which the ray crosses the next boundary on each axis
+  vec3 tDelta;   // t between boundaries on each axis
+  ivec3 dims;
+};
+
+// Clips [tMin, tMax] to the grid [origin, origin + dims * cellSize] and sets up the walk.
+// Returns false when the ray misses the grid.
+PLUME_FN bool dda_init(OUT(DdaState) s, vec3 o, vec3 d, float tMin, float tMax, vec3 origin,
+                       float cellSize, ivec3 dims) {
+  s.dims = dims;
+  float t0 = tMin;
+  float t1 = tMax;
+  for (int a = 0; a < 3; ++a) {
+    float lo = origin[a];
+    float hi = origin[a] + float(dims[a]) * cellSize;
+    if (abs(d[a]) < 1e-30f) {
+      if (o[a] < lo || o[a] >= hi) t1 = -1.0f;
+    } else {
+      float ta = (lo - o[a]) / d[a];
+      float tb = (hi - o[a]) / d[a];
+      t0 = max(t0, min(ta, tb));
+      t1 = min(t1, max(ta, tb));
+    }
+  }
+  s.t = t0;
+  s.tEnd = t1;
+  if (!(t0 < t1)) return false;
+  vec3 p = o + t0 * d;
+  for (int a = 0; a < 3; ++a) {
+    s.cell[a] = clamp(int(floor((p[a] - origin[a]) / cellSize)), 0, dims[a] - 1);
+    if (abs(d[a]) < 1e-30f) {
+      s.stepDir[a] = 0;
+      s.tNext[a] = DDA_INF;
+      s.tDelta[a] = DDA_INF;
+    } else {
+      s.stepDir[a] = d[a] > 0.0f ? 1 : -1;
+      float boundary = origin[a] + float(s.cell[a] + (d[a] > 0.0f ? 1 : 0)) * cellSize;
+      s.tNext[a] = (boundary - o[a]) / d[a];
+      s.tDelta[a] = cellSize / abs(d[a]);
+    }
+  }
+  return true;
+}
+
+// The next segment [t0, t1) and its cell; false when the ray has left the grid.
+PLUME_FN bool dda_next(INOUT(DdaState) s, OUT(float) t0, OUT(float) t1, OUT(ivec3) cell) {
+  cell = s.cell;
+  t0 = s.t;
+  t1 = s.t;
+  if (!(s.t < s.tEnd)) return false;
+  int axis = 0;
+  if (s.tNext.y < s.tNext[axis]) axis = 1;
+  if (s.tNext.z < s.tNext[axis]) axis = 2;
+  t1 = min(s.tNext[axis], s.tEnd);
+  s.t = t1;
+  s.cell[axis] += s.stepDir[axis];
+  s.tNext[axis] += s.tDelta[axis];
+  if (s.cell[axis] < 0 || s.cell[axis] >= s.dims[axis]) s.t = s.tEnd;
+  return true;
+}
+
+PLUME_NS_END
+
+#endif

@@ -1,0 +1,72 @@
+// The Vulkan instance, the chosen physical device and a logical device with one compute queue.
+// Device choice: a discrete GPU, then an integrated one, then anything else (lavapipe);
+// `deviceName` (a case-insensitive substring) forces one. Validation layers are enabled when
+// asked for or when PLUME_VALIDATION=1; every validation message is printed and counted, and
+// the tests fail on any.
+#pragma once
+
+#include <vulkan/vulkan.h>
+
+#include <atomic>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace plume::gpu {
+
+struct ContextOptions {
+  std::string deviceName;  // empty: choose automatically
+  bool validation = false;
+  bool verbose = true;     // print the chosen device
+};
+
+class Context {
+ public:
+  explicit Context(const ContextOptions& options = {});
+  ~Context();
+  Context(const Context&) = delete;
+  Context& operator=(const Context&) = delete;
+
+  VkDevice device() const { return device_; }
+  VkPhysicalDevice physicalDevice() const { return physical_; }
+  VkQueue queue() const { return queue_; }
+  uint32_t queueFamily() const { return queueFamily_; }
+  VkCommandPool commandPool() const { return pool_; }
+  const VkPhysicalDeviceProperties& properties() const { return props_; }
+  const VkPhysicalDeviceLimits& limits() const { return props_.limits; }
+  std::string deviceName() const { return props_.deviceName; }
+  bool isCpuDevice() const { return props_.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU; }
+  bool validationEnabled() const { return validation_; }
+  uint64_t validationMessages() const { return validationMessages_.load(); }
+
+  // A memory type allowed by typeBits with all of `required` (and `preferred` if possible).
+  uint32_t findMemoryType(uint32_t typeBits, VkMemoryPropertyFlags required,
+                          VkMemoryPropertyFlags preferred = 0) const;
+  VkMemoryPropertyFlags memoryTypeFlags(uint32_t type) const;
+
+  // Records into a fresh primary command buffer, submits it and waits.
+  void submitAndWait(const std::function<void(VkCommandBuffer)>& record);
+
+  static std::vector<std::string> listDevices();
+
+  // Internal: called by the debug messenger.
+  void onValidationMessage(const char* message);
+
+ private:
+  void release();
+
+  VkInstance instance_ = VK_NULL_HANDLE;
+  VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+  VkPhysicalDevice physical_ = VK_NULL_HANDLE;
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkQueue queue_ = VK_NULL_HANDLE;
+  uint32_t queueFamily_ = 0;
+  VkCommandPool pool_ = VK_NULL_HANDLE;
+  VkFence fence_ = VK_NULL_HANDLE;
+  VkPhysicalDeviceProperties props_{};
+  VkPhysicalDeviceMemoryProperties memProps_{};
+  bool validation_ = false;
+  std::atomic<uint64_t> validationMessages_{0};
+};
+
+}  // namespace plume::gpu

@@ -1,0 +1,101 @@
+// Compute pipelines, their descriptor sets, and a pass = pipeline + set + dispatch, timed with
+// timestamp queries (GpuTimer). Descriptor bindings are given as a list: binding i has type
+// bindings[i], all in set 0, all visible to the compute stage.
+#pragma once
+
+#include "gpu/context.h"
+#include "gpu/resources.h"
+
+#include <glm/vec3.hpp>
+#include <vulkan/vulkan.h>
+
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace plume::gpu {
+
+enum class BindingType { StorageBuffer, UniformBuffer, SampledImage };
+
+class ComputePipeline {
+ public:
+  ComputePipeline(Context& ctx, const std::vector<uint32_t>& spirv, std::vector<BindingType> bindings,
+                  uint32_t pushConstantBytes, std::string name);
+  ~ComputePipeline();
+  ComputePipeline(const ComputePipeline&) = delete;
+  ComputePipeline& operator=(const ComputePipeline&) = delete;
+
+  VkPipeline pipeline() const { return pipeline_; }
+  VkPipelineLayout layout() const { return layout_; }
+  VkDescriptorSetLayout setLayout() const { return setLayout_; }
+  const std::vector<BindingType>& bindings() const { return bindings_; }
+  uint32_t pushConstantBytes() const { return pushBytes_; }
+  const std::string& name() const { return name_; }
+
+ private:
+  Context& ctx_;
+  std::vector<BindingType> bindings_;
+  uint32_t pushBytes_;
+  std::string name_;
+  VkShaderModule module_ = VK_NULL_HANDLE;
+  VkDescriptorSetLayout setLayout_ = VK_NULL_HANDLE;
+  VkPipelineLayout layout_ = VK_NULL_HANDLE;
+  VkPipeline pipeline_ = VK_NULL_HANDLE;
+};
+
+class DescriptorSet {
+ public:
+  DescriptorSet(Context& ctx, const ComputePipeline& pipeline);
+  ~DescriptorSet();
+  DescriptorSet(const DescriptorSet&) = delete;
+  DescriptorSet& operator=(const DescriptorSet&) = delete;
+
+  void bind(uint32_t binding, const Buffer& buffer);
+  void bind(uint32_t binding, const Image3D& image);
+  VkDescriptorSet handle() const { return set_; }
+
+ private:
+  Context& ctx_;
+  const ComputePipeline& pipeline_;
+  VkDescriptorPool pool_ = VK_NULL_HANDLE;
+  VkDescriptorSet set_ = VK_NULL_HANDLE;
+};
+
+// Per-pass GPU times from timestamp queries, in milliseconds.
+class GpuTimer {
+ public:
+  explicit GpuTimer(Context& ctx, uint32_t maxScopes = 32);
+  ~GpuTimer();
+  GpuTimer(const GpuTimer&) = delete;
+  GpuTimer& operator=(const GpuTimer&) = delete;
+
+  bool supported() const { return supported_; }
+  void reset(VkCommandBuffer cmd);
+  uint32_t begin(VkCommandBuffer cmd, const std::string& name);
+  void end(VkCommandBuffer cmd, uint32_t scope);
+  // After the command buffer completed: (name, ms) per scope, in recording order.
+  std::vector<std::pair<std::string, double>> read();
+
+ private:
+  Context& ctx_;
+  VkQueryPool pool_ = VK_NULL_HANDLE;
+  uint32_t maxScopes_;
+  std::vector<std::string> names_;
+  bool supported_ = false;
+};
+
+// Full compute->compute and compute->transfer memory barrier.
+void computeBarrier(VkCommandBuffer cmd);
+
+struct ComputePass {
+  ComputePass(Context& ctx, const std::vector<uint32_t>& spirv, std::vector<BindingType> bindings,
+              uint32_t pushConstantBytes, std::string name, glm::uvec3 localSize);
+  // Dispatches enough groups to cover `items` threads; records timestamps if a timer is given.
+  void record(VkCommandBuffer cmd, glm::uvec3 items, const void* push = nullptr, GpuTimer* timer = nullptr) const;
+
+  ComputePipeline pipeline;
+  DescriptorSet set;
+  glm::uvec3 localSize;
+};
+
+}  // namespace plume::gpu

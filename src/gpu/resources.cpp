@@ -1,0 +1,206 @@
+#include "gpu/resources.h"
+
+#include "core/error.h"
+#include "core/log.h"
+#include "gpu/check.h"
+
+#include <cstring>
+#include <utility>
+
+namespace plume::gpu {
+
+// ---------------------------------------------------------------------------------------------
+Buffer::Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, const std::string& name,
+               MemoryUse use)
+    : ctx_(&ctx), size_(size) {
+  if (size == 0) size = size_ = 4;  // Vulkan forbids empty buffers; an empty array binds 4 bytes
+  if ((usage & VK_BUFFER_USAGE_STORAGE_BUFFER_BIT) && size > ctx.limits().maxStorageBufferRange) {
+    throw DeviceError(strf("%s: %s needs %.1f MiB, more than the device's storage buffer limit of %.1f MiB",
+                           ctx.deviceName().c_str(), name.c_str(), size / 1048576.0,
+                           ctx.limits().maxStorageBufferRange / 1048576.0));
+  }
+  VkBufferCreateInfo bi{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  bi.size = size;
+  bi.usage = usage | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  bi.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  PLUME_VK(vkCreateBuffer(ctx.device(), &bi, nullptr, &buffer_));
+  VkMemoryRequirements req;
+  vkGetBufferMemoryRequirements(ctx.device(), buffer_, &req);
+  VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  ai.allocationSize = req.size;
+  const VkMemoryPropertyFlags host = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+  ai.memoryTypeIndex = use == MemoryUse::Staging
+                           ? ctx.findMemoryType(req.memoryTypeBits, host)
+                           : ctx.findMemoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, host);
+  VkResult r = vkAllocateMemory(ctx.device(), &ai, nullptr, &memory_);
+  if (r != VK_SUCCESS) {
+    release();
+    throw DeviceError(strf("%s: cannot allocate %.1f MiB for %s (%s)", ctx.deviceName().c_str(),
+                           req.size / 1048576.0, name.c_str(), vkResultName(r)));
+  }
+  PLUME_VK(vkBindBufferMemory(ctx.device(), buffer_, memory_, 0));
+  if ((ctx.memoryTypeFlags(ai.memoryTypeIndex) & host) == host) {
+    PLUME_VK(vkMapMemory(ctx.device(), memory_, 0, VK_WHOLE_SIZE, 0, &mapped_));
+  }
+}
+
+Buffer::~Buffer() { release(); }
+
+Buffer& Buffer::operator=(Buffer&& o) noexcept {
+  if (this != &o) {
+    release();
+    ctx_ = std::exchange(o.ctx_, nullptr);
+    buffer_ = std::exchange(o.buffer_, VK_NULL_HANDLE);
+    memory_ = std::exchange(o.memory_, VK_NULL_HANDLE);
+    size_ = std::exchange(o.size_, 0);
+    mapped_ = std::exchange(o.mapped_, nullptr);
+  }
+  return *this;
+}
+
+void Buffer::release() {
+  if (!ctx_) return;
+  if (buffer_) vkDestroyBuffer(ctx_->device(), buffer_, nullptr);
+  if (memory_) vkFreeMemory(ctx_->device(), memory_, nullptr);
+  buffer_ = VK_NULL_HANDLE;
+  memory_ = VK_NULL_HANDLE;
+  mapped_ = nullptr;
+}
+
+void Buffer::upload(const void* data, size_t bytes, size_t offset) {
+  PLUME_CHECK(offset + bytes <= size_);
+  if (bytes == 0) return;
+  if (mapped_) {
+    std::memcpy(static_cast<char*>(mapped_) + offset, data, bytes);
+    return;
+  }
+  Buffer staging(*ctx_, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, "staging", MemoryUse::Staging);
+  PLUME_CHECK(staging.mapped_);
+  std::memcpy(staging.mapped_, data, bytes);
+  ctx_->submitAndWait([&](VkCommandBuffer cmd) {
+    VkBufferCopy region{0, offset, bytes};
+    vkCmdCopyBuffer(cmd, staging.buffer_, buffer_, 1, &region);
+  });
+}
+
+void Buffer::download(void* data, size_t bytes, size_t offset) const {
+  PLUME_CHECK(offset + bytes <= size_);
+  if (bytes == 0) return;
+  if (mapped_) {
+    std::memcpy(data, static_cast<const char*>(mapped_) + offset, bytes);
+    return;
+  }
+  Buffer staging(*ctx_, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, "staging", MemoryUse::Staging);
+  PLUME_CHECK(staging.mapped_);
+  ctx_->submitAndWait([&](VkCommandBuffer cmd) {
+    VkBufferCopy region{offset, 0, bytes};
+    vkCmdCopyBuffer(cmd, buffer_, staging.buffer_, 1, &region);
+  });
+  std::memcpy(data, staging.mapped_, bytes);
+}
+
+void Buffer::fillZero() {
+  ctx_->submitAndWait([&](VkCommandBuffer cmd) { vkCmdFillBuffer(cmd, buffer_, 0, VK_WHOLE_SIZE, 0); });
+}
+
+// ---------------------------------------------------------------------------------------------
+Image3D::Image3D(Context& ctx, glm::ivec3 extent, VkFormat format, size_t texelBytes, const std::string& name)
+    : ctx_(&ctx), extent_(extent), texelBytes_(texelBytes) {
+  const uint32_t maxSide = ctx.limits().maxImageDimension3D;
+  if (uint32_t(extent.x) > maxSide || uint32_t(extent.y) > maxSide || uint32_t(extent.z) > maxSide) {
+    throw DeviceError(strf("%s: %s needs a %dx%dx%d 3D image; the device allows %u per side",
+                           ctx.deviceName().c_str(), name.c_str(), extent.x, extent.y, extent.z, maxSide));
+  }
+  VkImageCreateInfo ii{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
+  ii.imageType = VK_IMAGE_TYPE_3D;
+  ii.format = format;
+  ii.extent = {uint32_t(extent.x), uint32_t(extent.y), uint32_t(extent.z)};
+  ii.mipLevels = 1;
+  ii.arrayLayers = 1;
+  ii.samples = VK_SAMPLE_COUNT_1_BIT;
+  ii.tiling = VK_IMAGE_TILING_OPTIMAL;
+  ii.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+  ii.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+  PLUME_VK(vkCreateImage(ctx.device(), &ii, nullptr, &image_));
+  VkMemoryRequirements req;
+  vkGetImageMemoryRequirements(ctx.device(), image_, &req);
+  VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  ai.allocationSize = req.size;
+  ai.memoryTypeIndex = ctx.findMemoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+  VkResult r = vkAllocateMemory(ctx.device(), &ai, nullptr, &memory_);
+  if (r != VK_SUCCESS) {
+    release();
+    throw DeviceError(strf("%s: cannot allocate %.1f MiB for %s (%s)", ctx.deviceName().c_str(),
+                           req.size / 1048576.0, name.c_str(), vkResultName(r)));
+  }
+  PLUME_VK(vkBindImageMemory(ctx.device(), image_, memory_, 0));
+  VkImageViewCreateInfo vi{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
+  vi.image = image_;
+  vi.viewType = VK_IMAGE_VIEW_TYPE_3D;
+  vi.format = format;
+  vi.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+  PLUME_VK(vkCreateImageView(ctx.device(), &vi, nullptr, &view_));
+  VkSamplerCreateInfo si{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
+  si.magFilter = si.minFilter = VK_FILTER_NEAREST;
+  si.addressModeU = si.addressModeV = si.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+  PLUME_VK(vkCreateSampler(ctx.device(), &si, nullptr, &sampler_));
+}
+
+Image3D::~Image3D() { release(); }
+
+Image3D& Image3D::operator=(Image3D&& o) noexcept {
+  if (this != &o) {
+    release();
+    ctx_ = std::exchange(o.ctx_, nullptr);
+    image_ = std::exchange(o.image_, VK_NULL_HANDLE);
+    memory_ = std::exchange(o.memory_, VK_NULL_HANDLE);
+    view_ = std::exchange(o.view_, VK_NULL_HANDLE);
+    sampler_ = std::exchange(o.sampler_, VK_NULL_HANDLE);
+    extent_ = o.extent_;
+    texelBytes_ = o.texelBytes_;
+  }
+  return *this;
+}
+
+void Image3D::release() {
+  if (!ctx_) return;
+  VkDevice d = ctx_->device();
+  if (sampler_) vkDestroySampler(d, sampler_, nullptr);
+  if (view_) vkDestroyImageView(d, view_, nullptr);
+  if (image_) vkDestroyImage(d, image_, nullptr);
+  if (memory_) vkFreeMemory(d, memory_, nullptr);
+  sampler_ = VK_NULL_HANDLE;
+  view_ = VK_NULL_HANDLE;
+  image_ = VK_NULL_HANDLE;
+  memory_ = VK_NULL_HANDLE;
+}
+
+void Image3D::upload(const void* data, size_t bytes) {
+  PLUME_CHECK(bytes == size_t(extent_.x) * extent_.y * extent_.z * texelBytes_);
+  Buffer staging(*ctx_, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, "image staging", MemoryUse::Staging);
+  staging.upload(data, bytes);
+  ctx_->submitAndWait([&](VkCommandBuffer cmd) {
+    VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+    b.srcAccessMask = 0;
+    b.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    b.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    b.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = image_;
+    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0,
+                         nullptr, 1, &b);
+    VkBufferImageCopy region{};
+    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    region.imageExtent = {uint32_t(extent_.x), uint32_t(extent_.y), uint32_t(extent_.z)};
+    vkCmdCopyBufferToImage(cmd, staging.handle(), image_, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+    b.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
+    b.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    b.newLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0, nullptr, 0,
+                         nullptr, 1, &b);
+  });
+}
+
+}  // namespace plume::gpu

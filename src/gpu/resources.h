@@ -1,0 +1,73 @@
+// RAII Vulkan resources: buffers and 3D images with their memory. Move-only.
+// Memory: device-local and host-visible when the device has it (lavapipe, resizable BAR), else
+// device-local with staging copies through Context::submitAndWait.
+#pragma once
+
+#include "gpu/context.h"
+
+#include <glm/vec3.hpp>
+#include <vulkan/vulkan.h>
+
+#include <cstddef>
+#include <string>
+
+namespace plume::gpu {
+
+enum class MemoryUse {
+  Device,   // device-local, host-visible too where the device offers it
+  Staging,  // host-visible and coherent (transfers)
+};
+
+class Buffer {
+ public:
+  Buffer() = default;
+  // `name` appears in errors (e.g. a buffer larger than the device allows).
+  Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, const std::string& name,
+         MemoryUse use = MemoryUse::Device);
+  ~Buffer();
+  Buffer(Buffer&& o) noexcept { *this = std::move(o); }
+  Buffer& operator=(Buffer&& o) noexcept;
+
+  VkBuffer handle() const { return buffer_; }
+  VkDeviceSize size() const { return size_; }
+  bool valid() const { return buffer_ != VK_NULL_HANDLE; }
+
+  void upload(const void* data, size_t bytes, size_t offset = 0);
+  void download(void* data, size_t bytes, size_t offset = 0) const;
+  void fillZero();
+
+ private:
+  void release();
+  Context* ctx_ = nullptr;
+  VkBuffer buffer_ = VK_NULL_HANDLE;
+  VkDeviceMemory memory_ = VK_NULL_HANDLE;
+  VkDeviceSize size_ = 0;
+  void* mapped_ = nullptr;  // persistently mapped when host-visible
+};
+
+// A sampled 3D image (read with texelFetch) with a nearest sampler.
+class Image3D {
+ public:
+  Image3D() = default;
+  Image3D(Context& ctx, glm::ivec3 extent, VkFormat format, size_t texelBytes, const std::string& name);
+  ~Image3D();
+  Image3D(Image3D&& o) noexcept { *this = std::move(o); }
+  Image3D& operator=(Image3D&& o) noexcept;
+
+  void upload(const void* data, size_t bytes);
+  VkImageView view() const { return view_; }
+  VkSampler sampler() const { return sampler_; }
+  glm::ivec3 extent() const { return extent_; }
+
+ private:
+  void release();
+  Context* ctx_ = nullptr;
+  VkImage image_ = VK_NULL_HANDLE;
+  VkDeviceMemory memory_ = VK_NULL_HANDLE;
+  VkImageView view_ = VK_NULL_HANDLE;
+  VkSampler sampler_ = VK_NULL_HANDLE;
+  glm::ivec3 extent_{0};
+  size_t texelBytes_ = 0;
+};
+
+}  // namespace plume::gpu

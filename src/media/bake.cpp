@@ -1,0 +1,380 @@
+// The bake (DESIGN §3): OpenVDB float grid -> bricks in an atlas, indirection, majorant
+// hierarchy and coarse conservative mips. See bake.h for the layout; lookups are in bake_lookup.cpp.
+//
+// Pipeline (every pass parallel over bricks with TBB):
+//   1. core bricks: bricks whose own 8³ voxels hold a non-zero value (leaves and active tiles);
+//   2. candidates: core bricks dilated by one brick (only those can see a non-zero voxel in their
+//      10³ window, whose apron reaches one voxel into each neighbour);
+//   3. allocate the candidates whose window holds a non-zero voxel (core bricks always do);
+//   4. fill each allocated slot: texels, majorant, coarse cells; then the max hierarchy.
+#include "media/bake.h"
+
+#include "core/error.h"
+#include "media/vdb_loader.h"
+
+#include <openvdb/openvdb.h>
+
+#include <tbb/blocked_range.h>
+#include <tbb/combinable.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+namespace plume {
+namespace {
+
+using openvdb::Coord;
+using FloatTree = openvdb::FloatTree;
+using LeafT = FloatTree::LeafNodeType;
+using Window = std::array<float, kBrickTexelCount>;  // x fastest: [(z*10 + y)*10 + x]
+
+constexpr float kHalfMax = 65504.0f;
+// The lookup's float weights sum to 1 only within a few ulp, so a lookup whose 8 texels all
+// equal M can return M(1 + ~10 * 2^-24). Majorants are raised by 2^-18 (64 ulp) to bound it.
+constexpr float kMajorantMargin = 1.0f + 1.0f / 262144.0f;
+
+int windowIndex(int x, int y, int z) { return (z * kBrickTexels + y) * kBrickTexels + x; }
+
+size_t linearIndex(glm::ivec3 c, glm::ivec3 dims) {
+  return (size_t(c.z) * size_t(dims.y) + size_t(c.y)) * size_t(dims.x) + size_t(c.x);
+}
+
+glm::ivec3 delinearize(size_t i, glm::ivec3 dims) {
+  const size_t x = i % size_t(dims.x), yz = i / size_t(dims.x);
+  return {int(x), int(yz % size_t(dims.y)), int(yz / size_t(dims.y))};
+}
+
+glm::ivec3 brickOf(const Coord& c) { return {c.x() >> 3, c.y() >> 3, c.z() >> 3}; }  // floor(c/8)
+
+// Reads the 10³ window of brick b (voxels 8b-1 .. 8b+8) from the tree. The window overlaps
+// 3³ leaf-sized blocks; each is either a leaf (read from its buffer) or uniform (a tile or the
+// background, one getValue). Non-positive values (only zeros once sanitised) read as 0.
+void gatherWindow(openvdb::FloatGrid::ConstAccessor& acc, glm::ivec3 b, Window& w) {
+  // Along one axis, block offset d in {-1,0,1} covers window texels [lo, hi).
+  static constexpr int kLo[3] = {0, 1, 9}, kHi[3] = {1, 9, 10}, kLocal0[3] = {7, 0, 0};
+  for (int dz = 0; dz < 3; ++dz)
+    for (int dy = 0; dy < 3; ++dy)
+      for (int dx = 0; dx < 3; ++dx) {
+        const Coord block(8 * (b.x + dx - 1), 8 * (b.y + dy - 1), 8 * (b.z + dz - 1));
+        const LeafT* leaf = acc.probeConstLeaf(block);
+        const float uniform = leaf ? 0.0f : std::max(acc.getValue(block), 0.0f);
+        const float* data = leaf ? leaf->buffer().data() : nullptr;
+        for (int z = kLo[dz], lz = kLocal0[dz]; z < kHi[dz]; ++z, ++lz)
+          for (int y = kLo[dy], ly = kLocal0[dy]; y < kHi[dy]; ++y, ++ly)
+            for (int x = kLo[dx], lx = kLocal0[dx]; x < kHi[dx]; ++x, ++lx)
+              // LeafNode::coordToOffset: x slowest, z fastest.
+              w[windowIndex(x, y, z)] = data ? std::max(data[(lx << 6) + (ly << 3) + lz], 0.0f) : uniform;
+      }
+}
+
+bool anyPositive(const Window& w) {
+  return std::any_of(w.begin(), w.end(), [](float v) { return v > 0.0f; });
+}
+
+// --- Step 1-2: core and candidate bricks ------------------------------------------------------
+
+struct BrickBox {
+  glm::ivec3 origin{0}, dims{0};
+  size_t count() const { return size_t(dims.x) * size_t(dims.y) * size_t(dims.z); }
+  bool contains(glm::ivec3 b) const {
+    const glm::ivec3 r = b - origin;
+    return r.x >= 0 && r.y >= 0 && r.z >= 0 && r.x < dims.x && r.y < dims.y && r.z < dims.z;
+  }
+  size_t index(glm::ivec3 b) const { return linearIndex(b - origin, dims); }
+};
+
+// Marks the bricks whose own voxels hold a positive value.
+std::vector<uint8_t> coreBricks(const openvdb::FloatGrid& grid, const BrickBox& box) {
+  std::vector<uint8_t> core(box.count(), 0);
+  std::vector<const LeafT*> leaves;
+  grid.tree().getNodes(leaves);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves.size()), [&](const auto& r) {
+    for (size_t i = r.begin(); i != r.end(); ++i) {
+      const float* d = leaves[i]->buffer().data();
+      const glm::ivec3 b = brickOf(leaves[i]->origin());
+      if (box.contains(b) && std::any_of(d, d + LeafT::SIZE, [](float v) { return v > 0.0f; }))
+        core[box.index(b)] = 1;  // one leaf per brick: no races
+    }
+  });
+  auto it = grid.tree().cbeginValueOn();
+  it.setMaxDepth(FloatTree::ValueOnCIter::LEAF_DEPTH - 1);  // tiles only
+  for (; it; ++it) {
+    if (!(*it > 0.0f)) continue;
+    const openvdb::CoordBBox tile = it.getBoundingBox();
+    const glm::ivec3 lo = brickOf(tile.min()), hi = brickOf(tile.max());
+    for (int z = lo.z; z <= hi.z; ++z)
+      for (int y = lo.y; y <= hi.y; ++y)
+        for (int x = lo.x; x <= hi.x; ++x)
+          if (box.contains({x, y, z})) core[box.index({x, y, z})] = 1;
+  }
+  return core;
+}
+
+// Candidates = core dilated by one brick (26-neighbourhood), as brick-box indices in order.
+std::vector<size_t> candidateBricks(const std::vector<uint8_t>& core, const BrickBox& box) {
+  std::vector<uint8_t> cand(core.size(), 0);
+  tbb::parallel_for(0, box.dims.z, [&](int z) {
+    for (int y = 0; y < box.dims.y; ++y)
+      for (int x = 0; x < box.dims.x; ++x) {
+        bool any = false;
+        for (int dz = -1; dz <= 1 && !any; ++dz)
+          for (int dy = -1; dy <= 1 && !any; ++dy)
+            for (int dx = -1; dx <= 1 && !any; ++dx) {
+              const glm::ivec3 n = box.origin + glm::ivec3(x + dx, y + dy, z + dz);
+              any = box.contains(n) && core[box.index(n)];
+            }
+        cand[linearIndex({x, y, z}, box.dims)] = any;
+      }
+  });
+  std::vector<size_t> out;
+  for (size_t i = 0; i < cand.size(); ++i)
+    if (cand[i]) out.push_back(i);
+  return out;
+}
+
+// --- Step 4: per-slot contents ----------------------------------------------------------------
+
+// Quantises a texel to the storage format; returns the value a shader will read back.
+float storeTexel(BakedVolume& vol, size_t texel, float v) {
+  if (vol.format == TexelFormat::Float32) {
+    vol.atlasF32[texel] = v;
+    return v;
+  }
+  const openvdb::math::half h(std::min(v, kHalfMax));  // round to nearest; clamp, no Inf
+  vol.atlasF16[texel] = h.bits();
+  return float(h);
+}
+
+struct SlotResult {
+  float majorant = 0, maxAbsError = 0, maxValue = 0;
+};
+
+// Writes the window into slot `slot` of the atlas. The majorant is the max over the window of
+// both the float value and the stored value (half rounding may round up), so it bounds the
+// trilinear lookup of either: a convex combination of 8 window texels never exceeds their max.
+SlotResult writeTexels(BakedVolume& vol, uint32_t slot, const Window& w) {
+  SlotResult r;
+  const glm::ivec3 o = slotTexelOrigin(vol, slot);
+  for (int z = 0; z < kBrickTexels; ++z)
+    for (int y = 0; y < kBrickTexels; ++y) {
+      const size_t row = linearIndex(o + glm::ivec3(0, y, z), vol.atlasTexels);
+      for (int x = 0; x < kBrickTexels; ++x) {
+        const float v = w[windowIndex(x, y, z)];
+        const float s = storeTexel(vol, row + size_t(x), v);
+        r.majorant = std::max({r.majorant, v, s});
+        r.maxValue = std::max(r.maxValue, v);
+        r.maxAbsError = std::max(r.maxAbsError, std::abs(s - v));
+      }
+    }
+  return r;
+}
+
+// Dilated interior voxels (window 1..8 on each axis, stored x fastest in 8³): the voxel itself
+// if positive, else `fraction` of the max of its 26 neighbours, kept >= FLT_MIN (fraction 0
+// turns dilation off: the coarse mips are then not conservative, a test checks it).
+// The 3³ box max is separable: 1D maxima along x, then y, then z (all inside the window).
+void dilateInterior(const Window& w, float fraction, std::array<float, 512>& out) {
+  std::array<float, 8 * 10 * 10> mx;  // [z][y][x-1], x in 1..8
+  for (int z = 0; z < 10; ++z)
+    for (int y = 0; y < 10; ++y)
+      for (int x = 1; x <= 8; ++x) {
+        const float* r = &w[windowIndex(x, y, z)];
+        mx[(z * 10 + y) * 8 + x - 1] = std::max({r[-1], r[0], r[1]});
+      }
+  std::array<float, 8 * 8 * 10> my;  // [z][y-1][x-1]
+  for (int z = 0; z < 10; ++z)
+    for (int y = 1; y <= 8; ++y)
+      for (int x = 0; x < 8; ++x) {
+        const float* c = &mx[(z * 10 + y) * 8 + x];
+        my[(z * 8 + y - 1) * 8 + x] = std::max({c[-8], c[0], c[8]});
+      }
+  for (int z = 1; z <= 8; ++z)
+    for (int y = 0; y < 8; ++y)
+      for (int x = 0; x < 8; ++x) {
+        const float* c = &my[(z * 8 + y) * 8 + x];
+        const float m = std::max({c[-64], c[0], c[64]});  // max over the 3³ box
+        const float v = w[windowIndex(x + 1, y + 1, z)];
+        float d = v;
+        if (!(v > 0.0f) && m > 0.0f && fraction > 0.0f) d = std::max(fraction * m, std::numeric_limits<float>::min());
+        out[((z - 1) * 8 + y) * 8 + x] = d;
+      }
+}
+
+// Coarse cells of one brick. Why this is conservative: if d(p) > 0 with floor(p) = v in the
+// brick, one of the corners v + {0,1}³ is positive, so v itself or a 26-neighbour is, so the
+// dilated value at v is > 0; v lies in the coarse cell containing p (cells are aligned to
+// 2 or 4 voxels), and a mean of non-negative values with one positive term is positive.
+void writeCoarse(BakedVolume& vol, uint32_t slot, const Window& w, float fraction) {
+  std::array<float, 512> dil;  // interior voxels, x fastest
+  dilateInterior(w, fraction, dil);
+  auto mean = [&](int cell, int x0, int y0, int z0) {
+    double sum = 0.0;
+    for (int z = z0; z < z0 + cell; ++z)
+      for (int y = y0; y < y0 + cell; ++y)
+        for (int x = x0; x < x0 + cell; ++x) sum += dil[(z * 8 + y) * 8 + x];
+    const float m = float(sum / double(cell * cell * cell));
+    return sum > 0.0 ? std::max(m, std::numeric_limits<float>::min()) : 0.0f;  // no underflow to 0
+  };
+  float* c1 = &vol.coarse1[size_t(slot) * 64];
+  for (int z = 0; z < 4; ++z)
+    for (int y = 0; y < 4; ++y)
+      for (int x = 0; x < 4; ++x) c1[(z * 4 + y) * 4 + x] = mean(2, 2 * x, 2 * y, 2 * z);
+  float* c2 = &vol.coarse2[size_t(slot) * 8];
+  for (int z = 0; z < 2; ++z)
+    for (int y = 0; y < 2; ++y)
+      for (int x = 0; x < 2; ++x) c2[(z * 2 + y) * 2 + x] = mean(4, 4 * x, 4 * y, 4 * z);
+}
+
+// --- Layout -------------------------------------------------------------------------------------
+
+// Slots per atlas axis: close to a cube, each axis at most maxPerAxis.
+glm::ivec3 atlasLayout(uint32_t slots, int maxPerAxis, const std::string& where) {
+  auto ceilDiv = [](uint64_t a, uint64_t b) { return (a + b - 1) / b; };
+  const int x = std::min<int>(maxPerAxis, int(std::ceil(std::cbrt(double(slots)))));
+  const uint64_t rest = ceilDiv(slots, uint64_t(x));
+  const int y = std::min<int>(maxPerAxis, int(std::ceil(std::sqrt(double(rest)))));
+  const uint64_t z = ceilDiv(rest, uint64_t(y));
+  if (z > uint64_t(maxPerAxis))
+    throw InputError(where + ": " + std::to_string(slots) + " bricks do not fit one atlas");
+  return {x, y, int(z)};
+}
+
+void buildHierarchy(BakedVolume& vol, const std::vector<float>& brickMajorant) {
+  vol.maxLevels.clear();
+  vol.maxLevels.push_back({1, vol.brickDims, brickMajorant});
+  // Coarser levels until every axis has at most kHierarchyFactor cells (at least one level).
+  while (vol.maxLevels.size() == 1 ||
+         glm::any(glm::greaterThan(vol.maxLevels.back().dims, glm::ivec3(kHierarchyFactor)))) {
+    const MaxLevel& fine = vol.maxLevels.back();
+    MaxLevel coarse;
+    coarse.cellBricks = fine.cellBricks * kHierarchyFactor;
+    coarse.dims = (fine.dims + kHierarchyFactor - 1) / kHierarchyFactor;
+    coarse.max.assign(size_t(coarse.dims.x) * coarse.dims.y * coarse.dims.z, 0.0f);
+    for (size_t i = 0; i < fine.max.size(); ++i) {
+      const glm::ivec3 c = delinearize(i, fine.dims) / kHierarchyFactor;
+      float& m = coarse.max[linearIndex(c, coarse.dims)];
+      m = std::max(m, fine.max[i]);
+    }
+    vol.maxLevels.push_back(std::move(coarse));
+    if (vol.maxLevels.back().dims == glm::ivec3(1)) break;
+  }
+}
+
+void setTransform(BakedVolume& vol, const openvdb::FloatGrid& grid, const openvdb::CoordBBox& active) {
+  // OpenVDB's Mat4 acts on row vectors (v * M, translation in row 3); glm on column vectors
+  // with m[col][row]: the same numbers in the same places give the same map.
+  const openvdb::Mat4d m = grid.transform().baseMap()->getAffineMap()->getMat4();
+  const openvdb::Mat4d inv = m.inverse();
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) {
+      vol.indexToWorld[i][j] = float(m(i, j));
+      vol.worldToIndex[i][j] = float(inv(i, j));
+    }
+  if (active.empty()) return;
+  // Trilinear support: d can be non-zero only strictly inside the active box grown by one voxel.
+  vol.indexBoundsMin = glm::vec3(active.min().x(), active.min().y(), active.min().z()) - 1.0f;
+  vol.indexBoundsMax = glm::vec3(active.max().x(), active.max().y(), active.max().z()) + 1.0f;
+  openvdb::BBoxd world;
+  for (int c = 0; c < 8; ++c) {
+    const openvdb::Vec3d p((c & 1) ? vol.indexBoundsMax.x : vol.indexBoundsMin.x,
+                           (c & 2) ? vol.indexBoundsMax.y : vol.indexBoundsMin.y,
+                           (c & 4) ? vol.indexBoundsMax.z : vol.indexBoundsMin.z);
+    world.expand(grid.transform().indexToWorld(p));
+  }
+  vol.worldBoundsMin = glm::vec3(world.min().x(), world.min().y(), world.min().z());
+  vol.worldBoundsMax = glm::vec3(world.max().x(), world.max().y(), world.max().z());
+}
+
+// Steps 3-4 over the candidate bricks of `box`.
+void fillBricks(BakedVolume& vol, const openvdb::FloatGrid& grid, const BrickBox& box,
+                const std::vector<size_t>& cand, const std::vector<uint8_t>& core,
+                const BakeOptions& opt, const std::string& where) {
+  // Step 3: which candidates see a non-zero voxel.
+  std::vector<uint8_t> alloc(cand.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, cand.size()), [&](const auto& r) {
+    openvdb::FloatGrid::ConstAccessor acc = grid.getConstAccessor();
+    Window w;
+    for (size_t i = r.begin(); i != r.end(); ++i) {
+      if (core[cand[i]]) { alloc[i] = 1; continue; }
+      gatherWindow(acc, box.origin + delinearize(cand[i], box.dims), w);
+      alloc[i] = anyPositive(w);
+    }
+  });
+  std::vector<std::pair<size_t, uint32_t>> slots;  // (brick-box index, slot)
+  for (size_t i = 0; i < cand.size(); ++i)
+    if (alloc[i]) slots.emplace_back(cand[i], uint32_t(slots.size() + 1));
+  vol.slotCount = uint32_t(slots.size() + 1);
+  vol.atlasSlots = atlasLayout(vol.slotCount, opt.maxAtlasSlotsPerAxis, where);
+  vol.atlasTexels = vol.atlasSlots * kBrickTexels;
+  const size_t texels = size_t(vol.atlasTexels.x) * vol.atlasTexels.y * vol.atlasTexels.z;
+  if (vol.format == TexelFormat::Float32) vol.atlasF32.assign(texels, 0.0f);
+  else vol.atlasF16.assign(texels, 0);
+  vol.coarse1.assign(size_t(vol.slotCount) * 64, 0.0f);
+  vol.coarse2.assign(size_t(vol.slotCount) * 8, 0.0f);
+  std::vector<float> brickMajorant(box.count(), 0.0f);
+  for (const auto& [b, s] : slots) vol.indirection[b] = s;
+
+  // Step 4: texels, majorants, coarse cells. Slots are disjoint, so writes never race.
+  tbb::combinable<SlotResult> worst;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, slots.size()), [&](const auto& r) {
+    openvdb::FloatGrid::ConstAccessor acc = grid.getConstAccessor();
+    Window w;
+    SlotResult& mine = worst.local();
+    for (size_t i = r.begin(); i != r.end(); ++i) {
+      const auto [b, s] = slots[i];
+      gatherWindow(acc, box.origin + delinearize(b, box.dims), w);
+      const SlotResult res = writeTexels(vol, s, w);
+      brickMajorant[b] = res.majorant * kMajorantMargin;
+      mine.maxAbsError = std::max(mine.maxAbsError, res.maxAbsError);
+      mine.maxValue = std::max(mine.maxValue, res.maxValue);
+      writeCoarse(vol, s, w, opt.dilationFraction);
+    }
+  });
+  worst.combine_each([&](const SlotResult& r) {
+    vol.stats.maxAbsError = std::max(vol.stats.maxAbsError, r.maxAbsError);
+    vol.stats.maxValue = std::max(vol.stats.maxValue, r.maxValue);
+  });
+  vol.stats.candidateBricks = cand.size();
+  vol.stats.allocatedBricks = uint32_t(slots.size());
+  buildHierarchy(vol, brickMajorant);
+}
+
+}  // namespace
+
+const char* texelFormatName(TexelFormat format) {
+  return format == TexelFormat::Float32 ? "float32" : "float16";
+}
+
+BakedVolume bakeVolume(const LoadedGrid& loaded, const BakeOptions& opt) {
+  const auto start = std::chrono::steady_clock::now();
+  const openvdb::FloatGrid& grid = *loaded.grid;
+  const std::string where = (loaded.path.empty() ? std::string("<memory>") : loaded.path) +
+                            " (grid \"" + loaded.name + "\")";
+  BakedVolume vol;
+  vol.format = opt.format;
+  vol.stats.activeVoxels = grid.activeVoxelCount();
+  const openvdb::CoordBBox active =
+      vol.stats.activeVoxels ? grid.evalActiveVoxelBoundingBox() : openvdb::CoordBBox();
+  setTransform(vol, grid, active);
+
+  BrickBox box;
+  if (!active.empty()) {  // active bricks plus one brick of margin (apron-only bricks)
+    box.origin = brickOf(active.min()) - 1;
+    box.dims = brickOf(active.max()) + 1 - box.origin + 1;
+    if (double(box.dims.x) * box.dims.y * box.dims.z > double(std::numeric_limits<int32_t>::max()))
+      throw InputError(where + ": active region too large for a dense brick indirection");
+  }
+  vol.brickOrigin = box.origin;
+  vol.brickDims = box.dims;
+  vol.indirection.assign(box.count(), 0);
+  const std::vector<uint8_t> core = coreBricks(grid, box);
+  fillBricks(vol, grid, box, candidateBricks(core, box), core, opt, where);
+  vol.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return vol;
+}
+
+}  // namespace plume

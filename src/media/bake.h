@@ -1,0 +1,122 @@
+// The baked volume (DESIGN §3): flat arrays ready for upload to the GPU, plus CPU lookups that
+// mirror the shaders (the tests compare them against openvdb::tools::BoxSampler).
+//
+// Index space: voxel centres at integer coordinates; d(p) is the trilinear interpolation of the
+// 8 voxels floor(p) + {0,1}³ (DESIGN §2). Brick b (integer 3-vector) owns voxels 8b .. 8b+7 and
+// stores the 10³ window of voxels 8b-1 .. 8b+8 (a one-voxel apron), so a lookup at any p with
+// floor(p) in brick b reads only that brick's texels. A brick is allocated iff its window holds a
+// non-zero voxel; every other brick maps to slot 0 (all zeros), so d(p) = 0 there exactly.
+//
+// No OpenVDB types here: this header is included by GPU upload code and by tests alike.
+#pragma once
+
+#include <glm/glm.hpp>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace plume {
+
+struct LoadedGrid;  // media/vdb_loader.h
+
+constexpr int kBrickVoxels = 8;    // voxels per brick edge
+constexpr int kBrickTexels = 10;   // texels per brick edge in the atlas (8 + apron of 1 each side)
+constexpr int kBrickTexelCount = kBrickTexels * kBrickTexels * kBrickTexels;
+constexpr int kHierarchyFactor = 4;  // a hierarchy cell covers 4³ cells of the level below
+constexpr int kCoarse1Cells = 4;     // coarse level 1: 4³ cells of 2³ voxels per brick
+constexpr int kCoarse2Cells = 2;     // coarse level 2: 2³ cells of 4³ voxels per brick
+
+enum class TexelFormat : uint32_t { Float32 = 0, Float16 = 1 };  // R32F or R16F atlas
+const char* texelFormatName(TexelFormat format);                 // "float32", "float16"
+
+struct BakeOptions {
+  TexelFormat format = TexelFormat::Float16;
+  // Dilation for the coarse mips: a zero voxel whose 26-neighbourhood holds a non-zero voxel gets
+  // this fraction of the neighbourhood's max (kept >= FLT_MIN, so it stays positive). 0 turns
+  // dilation off, which breaks the conservative guarantee (for tests only).
+  float dilationFraction = 0.25f;
+  int maxAtlasSlotsPerAxis = 204;  // 204 * 10 = 2040 texels, under a 2048 3D-image limit
+};
+
+// One level of the max hierarchy used for empty-space skipping (DDA). Level 0 is the per-brick
+// majorant; level k cells cover kHierarchyFactor^k bricks per edge. Cell (0,0,0) of every level
+// starts at brick BakedVolume::brickOrigin. Arrays are dense, x fastest: [(z*dims.y + y)*dims.x + x].
+struct MaxLevel {
+  int cellBricks = 1;      // bricks per cell edge
+  glm::ivec3 dims{0};      // cells per axis
+  std::vector<float> max;  // max of d over the cell (>= every trilinear value inside it)
+};
+
+struct BakeStats {
+  double seconds = 0;            // wall time of bakeVolume
+  uint64_t activeVoxels = 0;     // of the grid, tile voxels included
+  uint64_t candidateBricks = 0;  // bricks whose window was inspected
+  uint32_t allocatedBricks = 0;  // slots in use, slot 0 excluded
+  float maxAbsError = 0;         // max |stored texel - float grid value| over all texels
+  float maxValue = 0;            // max grid value (over allocated windows)
+};
+
+struct BakedVolume {
+  TexelFormat format = TexelFormat::Float16;
+
+  // Indirection: dense over the allocated bricks' bounding box (the active bricks plus one brick
+  // of margin, where only apron voxels can be non-zero). Brick b maps to
+  // indirection[linear(b - brickOrigin)]; a brick outside the box reads slot 0.
+  glm::ivec3 brickOrigin{0};
+  glm::ivec3 brickDims{0};
+  std::vector<uint32_t> indirection;  // atlas slot per brick, 0 = empty
+
+  // Atlas: slotCount slots (slot 0 = zeros) of 10³ texels, laid out as a 3D texture of
+  // atlasSlots slots per axis; slot s starts at texel 10 * (s % X, (s / X) % Y, s / (X*Y)).
+  // Exactly one of atlasF32 / atlasF16 (IEEE half bits) holds texels, x fastest over atlasTexels.
+  uint32_t slotCount = 1;
+  glm::ivec3 atlasSlots{1};
+  glm::ivec3 atlasTexels{kBrickTexels};
+  std::vector<float> atlasF32;
+  std::vector<uint16_t> atlasF16;
+
+  // Majorant hierarchy: levels[0] is per brick: the max over its 10³ window (of the float values
+  // and of the stored texels) times (1 + 2^-18), which bounds the float rounding of a lookup.
+  std::vector<MaxLevel> maxLevels;
+
+  // Coarse conservative mips, per slot (slot 0 zeros), float32 so tiny positive values survive:
+  // coarse1[slot*64 + (z*4+y)*4+x] = mean of the dilated grid over voxels 8b + 2(x,y,z) + {0,1}³,
+  // coarse2[slot*8 + (z*2+y)*2+x]  = mean over voxels 8b + 4(x,y,z) + {0..3}³.
+  std::vector<float> coarse1;
+  std::vector<float> coarse2;
+
+  // Index -> world affine map of the grid (column vectors: world = indexToWorld * (i,j,k,1)).
+  glm::mat4 indexToWorld{1.0f};
+  glm::mat4 worldToIndex{1.0f};
+  // Where d may be non-zero: the active index box grown by one voxel, and its world AABB.
+  glm::vec3 indexBoundsMin{0.0f}, indexBoundsMax{0.0f};
+  glm::vec3 worldBoundsMin{0.0f}, worldBoundsMax{0.0f};
+
+  BakeStats stats;
+  bool empty() const { return slotCount <= 1; }
+};
+
+struct MemoryReport {
+  uint64_t atlasBytes = 0, indirectionBytes = 0, majorantBytes = 0, coarseBytes = 0;
+  uint64_t totalBytes = 0;
+  double bytesPerActiveVoxel = 0;  // total / grid active voxels (0 for an empty grid)
+};
+
+// Bakes a sanitised grid (loadFloatGrid or sanitizeGrid output), in parallel (TBB). Throws
+// InputError naming the file when the grid does not fit the atlas or the dense indirection.
+BakedVolume bakeVolume(const LoadedGrid& grid, const BakeOptions& options = {});
+
+MemoryReport memoryReport(const BakedVolume& vol);
+
+// --- CPU mirrors of the shader lookups (all positions in index space) ------------------------
+float halfToFloat(uint16_t bits);                              // as GLSL unpackHalf2x16
+uint32_t brickSlot(const BakedVolume& vol, glm::ivec3 brick);  // 0 outside the indirection box
+glm::ivec3 slotTexelOrigin(const BakedVolume& vol, uint32_t slot);
+float atlasTexel(const BakedVolume& vol, glm::ivec3 texel);
+float sampleDensity(const BakedVolume& vol, glm::vec3 p);   // trilinear, 8 fetches, exact weights
+float sampleMajorant(const BakedVolume& vol, glm::vec3 p);  // = sampleMaxLevel(vol, 0, p)
+float sampleMaxLevel(const BakedVolume& vol, int level, glm::vec3 p);
+float sampleCoarse(const BakedVolume& vol, int level, glm::vec3 p);  // level 1 or 2, piecewise const
+
+}  // namespace plume

@@ -1,0 +1,71 @@
+#include "render/gpu_volume.h"
+
+#include "core/error.h"
+#include "core/log.h"
+
+#include <algorithm>
+
+namespace plume {
+
+GpuVolumeResources::GpuVolumeResources(gpu::Context& ctx, const BakedVolume& bake, float densityScale) {
+  using namespace shared;
+  const bool empty = bake.empty();
+  params_.worldToIndex = bake.worldToIndex;
+  params_.indexToWorld = bake.indexToWorld;
+  params_.brickOrigin = glm::ivec4(bake.brickOrigin, 0);
+  params_.brickDims = glm::ivec4(bake.brickDims, empty ? 1 : 0);
+  params_.atlasSlots = glm::ivec4(bake.atlasSlots, int(bake.format));
+  params_.boundsMin = glm::vec4(bake.indexBoundsMin, densityScale);
+  params_.boundsMax = glm::vec4(bake.indexBoundsMax, 0.0f);
+  const size_t levels = std::min<size_t>(bake.maxLevels.size(), GPU_MAX_LEVELS);
+  std::vector<float> majorants;
+  for (size_t k = 0; k < levels; ++k) {
+    const MaxLevel& L = bake.maxLevels[k];
+    params_.levelDims[k] = glm::ivec4(L.dims, L.cellBricks);
+    params_.levelOffset[int(k)] = uint32_t(majorants.size());
+    majorants.insert(majorants.end(), L.max.begin(), L.max.end());
+  }
+  if (!empty && (levels == 0 || bake.maxLevels[0].dims != bake.brickDims)) {
+    throw DeviceError("bake: level 0 of the majorant hierarchy must match the indirection grid");
+  }
+  params_.info = glm::uvec4(uint32_t(levels), 0, 0, 0);
+
+  const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+  paramBuffer_ = gpu::Buffer(ctx, sizeof(params_), storage, "volume parameters");
+  paramBuffer_.upload(&params_, sizeof(params_));
+
+  const bool f16 = bake.format == TexelFormat::Float16;
+  atlas_ = gpu::Image3D(ctx, bake.atlasTexels, f16 ? VK_FORMAT_R16_SFLOAT : VK_FORMAT_R32_SFLOAT,
+                        f16 ? 2 : 4, "brick atlas");
+  const size_t atlasBytes = f16 ? bake.atlasF16.size() * 2 : bake.atlasF32.size() * 4;
+  atlas_.upload(f16 ? (const void*)bake.atlasF16.data() : (const void*)bake.atlasF32.data(), atlasBytes);
+
+  indirection_ = gpu::Buffer(ctx, bake.indirection.size() * 4, storage, "brick indirection");
+  indirection_.upload(bake.indirection.data(), bake.indirection.size() * 4);
+  majorants_ = gpu::Buffer(ctx, majorants.size() * 4, storage, "majorant hierarchy");
+  majorants_.upload(majorants.data(), majorants.size() * 4);
+  counters_ = gpu::Buffer(ctx, 16, storage, "tracking counters");
+  resetCounters();
+  bytes_ = sizeof(params_) + atlasBytes + bake.indirection.size() * 4 + majorants.size() * 4;
+}
+
+void GpuVolumeResources::bind(gpu::DescriptorSet& set) const {
+  set.bind(0, paramBuffer_);
+  set.bind(1, atlas_);
+  set.bind(2, indirection_);
+  set.bind(3, majorants_);
+  set.bind(4, counters_);
+}
+
+uint32_t GpuVolumeResources::truncatedCount() const {
+  uint32_t c[4];
+  counters_.download(c, sizeof c);
+  return c[0];
+}
+
+void GpuVolumeResources::resetCounters() {
+  const uint32_t zero[4] = {0, 0, 0, 0};
+  counters_.upload(zero, sizeof zero);
+}
+
+}  // namespace plume

@@ -1,0 +1,37 @@
+// The baked volume on the device (DESIGN §3): the brick atlas as a 3D texture (R16F or R32F),
+// the indirection and the majorant hierarchy as storage buffers, the coarse mips (kept for
+// ReSTIR), and the GpuVolume parameter block. Bindings 0..4 of every volume pass
+// (shaders/volume/bindings.glsl).
+#pragma once
+
+#include "gpu/pipeline.h"
+#include "gpu/resources.h"
+#include "media/bake.h"
+#include "shaders/shared/gpu_types.h"
+
+namespace plume {
+
+class GpuVolumeResources {
+ public:
+  GpuVolumeResources(gpu::Context& ctx, const BakedVolume& bake, float densityScale);
+
+  // Binds params (0), atlas (1), indirection (2), majorants (3), counters (4).
+  void bind(gpu::DescriptorSet& set) const;
+  const shared::GpuVolume& params() const { return params_; }
+  uint64_t deviceBytes() const { return bytes_; }
+
+  // Tracking loops truncated by the step cap since the last reset (no silent caps).
+  uint32_t truncatedCount() const;
+  void resetCounters();
+
+ private:
+  shared::GpuVolume params_{};
+  gpu::Buffer paramBuffer_;
+  gpu::Image3D atlas_;
+  gpu::Buffer indirection_;
+  gpu::Buffer majorants_;
+  gpu::Buffer counters_;
+  uint64_t bytes_ = 0;
+};
+
+}  // namespace plume

@@ -1,0 +1,55 @@
+// The GPU delta-tracking path tracer (DESIGN §4.1) on top of the baked volume: one compute pass
+// (shaders/passes/pt.comp) compiled for the scene's feature set, progressive accumulation of the
+// mean and M2 per pixel, read back as mean + variance of the mean.
+#pragma once
+
+#include "gpu/pipeline.h"
+#include "gpu/shader_compiler.h"
+#include "io/image.h"
+#include "render/gpu_volume.h"
+#include "scene/scene.h"
+
+#include <memory>
+#include <string>
+
+namespace plume {
+
+// What a scene needs compiled in (DESIGN §5): light types present, multiple bounces.
+struct FeatureSet {
+  bool sun = false, point = false, environment = false, multiBounce = false;
+  gpu::ShaderDefines defines() const;
+  std::string name() const;  // e.g. "sun+env+multi"
+};
+FeatureSet featuresOf(const Scene& scene);
+
+// Per-pass GPU times of the last batch, ms.
+using PassTimes = std::vector<std::pair<std::string, double>>;
+
+class PathTracer {
+ public:
+  PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene);
+
+  const FeatureSet& features() const { return features_; }
+  // Binds a volume; call again when the volume changes (animation).
+  void setVolume(const GpuVolumeResources& volume);
+  // Clears the accumulation and sets the camera and seeds for `frame`.
+  void beginFrame(int frame);
+  // Traces `spp` more samples per pixel (one dispatch, waits for it).
+  void addSamples(int spp);
+  int samplesSoFar() const { return samples_; }
+  Image readImage() const;  // mean + variance of the mean
+  const PassTimes& lastPassTimes() const { return passTimes_; }
+
+ private:
+  gpu::Context& ctx_;
+  const Scene& scene_;
+  FeatureSet features_;
+  std::unique_ptr<gpu::ComputePass> pass_;
+  gpu::GpuTimer timer_;
+  gpu::Buffer frameBuffer_, lightBuffer_, accum_;
+  shared::GpuFrame frame_{};
+  int samples_ = 0;
+  PassTimes passTimes_;
+};
+
+}  // namespace plume

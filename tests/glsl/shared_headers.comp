@@ -1,0 +1,76 @@
+// Compile test (tests/CMakeLists.txt, ctest glsl_shared_headers): every shaders/shared/*.h
+// must compile as GLSL 450 for Vulkan 1.1. Each shared function is called once so that glslang
+// type-checks its body; the results go to a buffer so nothing is dead code.
+// A new header in shaders/shared must be included and exercised here (glsl_shared_headers_listed
+// checks that it is included).
+#version 450
+#extension GL_GOOGLE_include_directive : require
+
+#include "shared/common.h"
+#include "shared/rng.h"
+#include "shared/phase.h"
+#include "shared/sampling.h"
+#include "shared/reservoir.h"
+#include "shared/dda.h"
+#include "shared/gpu_types.h"
+
+layout(local_size_x = 64) in;
+
+layout(std430, binding = 0) buffer Out {
+  vec4 values[];
+};
+layout(std430, binding = 1) buffer Reservoirs {
+  RsPacked reservoirs[];
+};
+layout(std430, binding = 2) readonly buffer Params {
+  GpuVolume volume;
+  GpuFrame frame;
+  GpuLight lights[GPU_MAX_LIGHTS];
+};
+
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  // rng.h
+  RngState rng = rng_init(gl_GlobalInvocationID.xy, 0u, RNG_STREAM_TEST, 1u);
+  uvec4 h = rng_next4(rng);
+  float u0 = rng_float(rng) + rng_to_float(rng_uint(rng)) + float(h.x & 1u);
+  vec2 u = rng_float2(rng);
+  // common.h
+  vec3 b1;
+  vec3 b2;
+  plume_onb(vec3(0.0f, 0.0f, 1.0f), b1, b2);
+  float m = plume_max3(b1 + b2) * PLUME_PI * PLUME_INV_PI * PLUME_INV_4PI;
+  // phase.h
+  vec3 wo = ph_hg_sample(vec3(0.0f, 1.0f, 0.0f), 0.5f, u);
+  float sin2Theta;
+  float p = ph_hg(wo.y, 0.5f) + ph_hg_sample_cos(-0.3f, u.x) +
+            ph_hg_sample_cos_sin2(0.9f, u.y, sin2Theta) + sin2Theta;
+  // sampling.h
+  float t = smp_exponential(2.0f, u0 * 0.25f);
+  vec3 s = smp_uniform_sphere(u) + smp_uniform_cone(wo, 0.9f, u);
+  float pc = smp_uniform_cone_pdf(0.9f);
+  // reservoir.h
+  RsReservoir r = rs_empty();
+  bool picked = rs_stream(r, p, pc, 0.5f, u.x);
+  picked = rs_update(r, 0.25f, p, 1.0f, u.y) || picked;
+  RsReservoir other = r;
+  rs_finalize(other);
+  picked = rs_merge(r, other, p, 1.0f, 0.5f, u0) || picked;
+  rs_cap_confidence(r, 20.0f);
+  rs_finalize(r);
+  bool dropped;
+  RsReservoir back = rs_unpack(rs_pack(r), dropped);
+  reservoirs[i] = rs_pack(back);
+  // dda.h, gpu_types.h
+  DdaState dda;
+  float t0 = 0.0f;
+  float t1 = 0.0f;
+  ivec3 cell = ivec3(0);
+  if (dda_init(dda, vec3(0.5f), wo, 0.0f, DDA_INF, volume.boundsMin.xyz, 8.0f,
+               volume.brickDims.xyz)) {
+    dda_next(dda, t0, t1, cell);
+  }
+  s += vec3(cell) * (t1 - t0) + frame.albedo.xyz + lights[0].emission.xyz;
+  values[i] = vec4(s + wo, t + m + (picked ? 1.0f : 0.0f) + (dropped ? 2.0f : 0.0f) +
+                   (rs_is_finite(back.W) ? back.W : 0.0f));
+}

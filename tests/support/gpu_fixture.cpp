@@ -1,0 +1,50 @@
+#include "support/gpu_fixture.h"
+
+#include "media/vdb_loader.h"
+#include "render/gpu_volume.h"
+#include "render/path_tracer.h"
+
+namespace plume::test {
+
+std::unique_ptr<gpu::Context> GpuTest::ctx_;
+std::unique_ptr<gpu::ShaderCompiler> GpuTest::compiler_;
+
+void GpuTest::SetUpTestSuite() {
+  if (!ctx_) {
+    gpu::ContextOptions options;
+    options.validation = true;
+    options.verbose = true;
+    ctx_ = std::make_unique<gpu::Context>(options);
+    compiler_ = std::make_unique<gpu::ShaderCompiler>();
+  }
+}
+
+void GpuTest::TearDownTestSuite() {}
+
+void GpuTest::SetUp() { messagesBefore_ = ctx_->validationMessages(); }
+
+void GpuTest::TearDown() {
+  EXPECT_EQ(ctx_->validationMessages(), messagesBefore_) << "Vulkan validation reported problems (see stderr)";
+}
+
+Image renderGpuPt(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene,
+                  openvdb::FloatGrid::Ptr grid, int frame, GpuRenderInfo* info, TexelFormat format) {
+  LoadedGrid loaded;
+  loaded.grid = grid;
+  loaded.name = "density";
+  BakeOptions options;
+  options.format = format;
+  BakedVolume bake = bakeVolume(loaded, options);
+  GpuVolumeResources volume(ctx, bake, scene.media.at(0).densityScale);
+  PathTracer tracer(ctx, compiler, scene);
+  tracer.setVolume(volume);
+  tracer.beginFrame(frame);
+  for (int done = 0; done < scene.render.spp; done += 16) tracer.addSamples(std::min(16, scene.render.spp - done));
+  if (info) {
+    info->variant = tracer.features().name();
+    info->truncated = volume.truncatedCount();
+  }
+  return tracer.readImage();
+}
+
+}  // namespace plume::test

@@ -1,0 +1,45 @@
+// GPU test helpers: one Vulkan context per test program with validation layers on (every
+// validation message fails the test that caused it), the shader compiler without a disk cache,
+// and a one-call GPU path-traced render.
+#pragma once
+
+#include "gpu/context.h"
+#include "gpu/shader_compiler.h"
+#include "io/image.h"
+#include "media/bake.h"
+#include "scene/scene.h"
+
+#include <gtest/gtest.h>
+#include <openvdb/openvdb.h>
+
+#include <memory>
+
+namespace plume::test {
+
+class GpuTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite();
+  static void TearDownTestSuite();
+  void SetUp() override;
+  void TearDown() override;  // fails the test on new validation messages
+
+  static gpu::Context& ctx() { return *ctx_; }
+  static gpu::ShaderCompiler& compiler() { return *compiler_; }
+
+ private:
+  static std::unique_ptr<gpu::Context> ctx_;
+  static std::unique_ptr<gpu::ShaderCompiler> compiler_;
+  uint64_t messagesBefore_ = 0;
+};
+
+struct GpuRenderInfo {
+  std::string variant;
+  uint32_t truncated = 0;
+};
+
+// Bakes `grid`, renders scene.render.spp samples per pixel of `frame` with the GPU path tracer.
+Image renderGpuPt(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene,
+                  openvdb::FloatGrid::Ptr grid, int frame = 1, GpuRenderInfo* info = nullptr,
+                  TexelFormat format = TexelFormat::Float16);
+
+}  // namespace plume::test

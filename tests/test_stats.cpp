@@ -1,0 +1,262 @@
+// Tests of src/core/stats: the incomplete gamma and normal functions against known values, the
+// chi-square helper (accepts the right distribution, rejects a slightly wrong one, pools small
+// bins), relMSE, and the per-pixel Z-tests (pass for two independent estimates of the same
+// image, fail for a bias of a few standard errors in a region). Fixed seeds.
+#include "core/error.h"
+#include "core/stats.h"
+#include "support/test_support.h"
+
+#include "shaders/shared/rng.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <initializer_list>
+#include <filesystem>
+#include <limits>
+#include <vector>
+
+using namespace plume;
+using shared::RngState;
+
+namespace {
+
+constexpr int kSamples = 1000000;
+
+// Draws kSamples from the discrete distribution `p` (normalised here) by inverse CDF.
+std::vector<double> sampleCounts(std::vector<double> p, uint32_t seed) {
+  double sum = 0.0;
+  for (double& x : p) sum += x;
+  std::vector<double> cdf, counts(p.size(), 0.0);
+  double acc = 0.0;
+  for (double x : p) cdf.push_back(acc += x / sum);
+  RngState rng = shared::rng_init(glm::uvec2(seed, 0u), 0u, shared::RNG_STREAM_TEST, 41u);
+  for (int s = 0; s < kSamples; ++s) {
+    const double u = shared::rng_float(rng);
+    const size_t i = size_t(std::upper_bound(cdf.begin(), cdf.end(), u) - cdf.begin());
+    counts[std::min(i, p.size() - 1)] += 1.0;
+  }
+  return counts;
+}
+
+std::vector<double> expectedCounts(const std::vector<double>& p) {
+  double sum = 0.0;
+  for (double x : p) sum += x;
+  std::vector<double> e;
+  for (double x : p) e.push_back(kSamples * x / sum);
+  return e;
+}
+
+std::vector<double> linearWeights(int n, double tilt) {
+  std::vector<double> p;
+  for (int i = 0; i < n; ++i) p.push_back(1.0 + i + tilt * i * i);
+  return p;
+}
+
+constexpr int kSamplesPerPixel = 256;  // enough that the estimated variance is accurate
+
+// A pixel estimate: the mean of `n` noisy samples of `truth` (uniform noise of standard
+// deviation 0.3 * truth) and the variance of that mean estimated from the samples.
+struct Estimate {
+  float mean, varianceOfMean;
+};
+Estimate estimate(float truth, int n, RngState& rng) {
+  double sum = 0.0, sumSq = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const double x = truth * (1.0 + 0.3 * std::sqrt(12.0) * (shared::rng_float(rng) - 0.5));
+    sum += x;
+    sumSq += x * x;
+  }
+  const double mean = sum / n, var = (sumSq - n * mean * mean) / (n - 1);
+  return {float(mean), float(var / n)};
+}
+
+float truthAt(int x, int y, int c) {
+  return 0.5f + 0.4f * std::sin(0.2f * float(x) + 0.7f * float(c)) * std::cos(0.15f * float(y));
+}
+
+// A noisy estimate of the truth image; `bias` standard errors are added inside `region`.
+Image noisyImage(int w, int h, uint32_t seed, double bias = 0.0, int regionSize = 0) {
+  Image img;
+  img.width = w;
+  img.height = h;
+  img.rgb.assign(size_t(3 * w * h), 0.0f);
+  img.var.assign(img.rgb.size(), 0.0f);
+  RngState rng = shared::rng_init(glm::uvec2(seed, 1u), 0u, shared::RNG_STREAM_TEST, 42u);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        const size_t i = size_t(3 * (y * w + x) + c);
+        Estimate e = estimate(truthAt(x, y, c), kSamplesPerPixel, rng);
+        const bool inRegion = x >= 8 && x < 8 + regionSize && y >= 8 && y < 8 + regionSize;
+        img.rgb[i] = e.mean + (inRegion ? float(bias * std::sqrt(e.varianceOfMean)) : 0.0f);
+        img.var[i] = e.varianceOfMean;
+      }
+    }
+  }
+  return img;
+}
+
+}  // namespace
+
+TEST(Stats, IncompleteGammaKnownValues) {
+  for (double x : {0.01, 0.5, 1.0, 3.0, 10.0, 40.0}) {
+    EXPECT_NEAR(regularizedGammaQ(1.0, x), std::exp(-x), 1e-12) << x;
+    EXPECT_NEAR(regularizedGammaQ(0.5, x), std::erfc(std::sqrt(x)), 1e-12) << x;
+    for (double a : {0.5, 2.0, 7.5, 200.0}) {
+      EXPECT_NEAR(regularizedGammaP(a, x) + regularizedGammaQ(a, x), 1.0, 1e-12);
+    }
+  }
+  EXPECT_EQ(regularizedGammaQ(3.0, 0.0), 1.0);
+  // Chi-square critical values at p = 0.01 (tables): dof 1: 6.6349, dof 10: 23.2093,
+  // dof 100: 135.8067.
+  EXPECT_NEAR(chi2SurvivalFunction(6.6349, 1), 0.01, 1e-5);
+  EXPECT_NEAR(chi2SurvivalFunction(23.2093, 10), 0.01, 1e-5);
+  EXPECT_NEAR(chi2SurvivalFunction(135.8067, 100), 0.01, 1e-5);
+  EXPECT_NEAR(chi2SurvivalFunction(999.0 - 0.0, 999), 0.49, 0.01);  // median ~ dof - 2/3
+}
+
+TEST(Stats, NormalFunctions) {
+  EXPECT_NEAR(normalCdf(0.0), 0.5, 1e-15);
+  EXPECT_NEAR(normalCdf(1.959963985), 0.975, 1e-9);
+  EXPECT_NEAR(normalCdf(-3.0), 0.0013498980316301, 1e-12);
+  EXPECT_NEAR(twoSidedPValue(-1.959963985), 0.05, 1e-9);
+  EXPECT_NEAR(twoSidedPValue(2.575829304), 0.01, 1e-9);
+  EXPECT_NEAR(sidakLevel(0.01, 1.0), 0.01, 1e-15);
+  EXPECT_NEAR(sidakLevel(0.05, 1e6), 5.129329e-8, 1e-13);
+}
+
+TEST(Stats, Chi2AcceptsTheRightDistribution) {
+  const std::vector<double> p = linearWeights(40, 0.05);
+  Chi2Result r = chi2Test(sampleCounts(p, 1), expectedCounts(p));
+  EXPECT_TRUE(r.pass) << r.table;
+  EXPECT_EQ(r.dof, 39);
+  EXPECT_TRUE(r.message.empty());
+}
+
+TEST(Stats, Chi2RejectsASlightlyWrongDistribution) {
+  // Samples drawn with the quadratic term 10% larger than the one tested (bin probabilities
+  // off by at most 2%).
+  Chi2Result r = chi2Test(sampleCounts(linearWeights(40, 0.055), 2),
+                          expectedCounts(linearWeights(40, 0.05)));
+  EXPECT_FALSE(r.pass);
+  EXPECT_NE(r.table.find("FAILED"), std::string::npos) << r.table;
+  EXPECT_NE(r.table.find("(O-E)^2/E"), std::string::npos);
+}
+
+TEST(Stats, Chi2PoolsSmallBins) {
+  // 30 bins of expected count ~0.3 (9 together) and 10 large ones: the small ones are pooled.
+  std::vector<double> p(40, 1.0);
+  for (int i = 0; i < 30; ++i) p[size_t(i)] = 3e-6;
+  const std::vector<double> e = expectedCounts(p);
+  Chi2Result r = chi2Test(sampleCounts(p, 3), e);
+  EXPECT_TRUE(r.pass) << r.table;
+  EXPECT_EQ(r.pooledBins, 30);
+  EXPECT_EQ(r.dof, 10);  // 10 bins + the pool - 1
+}
+
+TEST(Stats, Chi2FailsOnSamplesWhereNoneAreExpected) {
+  std::vector<double> observed = {500.0, 480.0, 20.0}, expected = {500.0, 500.0, 0.0};
+  Chi2Result r = chi2Test(observed, expected);
+  EXPECT_FALSE(r.pass);
+  EXPECT_NE(r.message.find("expected count 0"), std::string::npos) << r.message;
+}
+
+TEST(Stats, RelMse) {
+  Image a = noisyImage(16, 8, 5);
+  EXPECT_EQ(relMse(a, a), 0.0);
+  const std::vector<float> x = {1.1f, 0.0f}, r = {1.0f, 0.1f};
+  EXPECT_NEAR(relMse(x, r), 0.5 * (0.01 / 1.01 + 0.01 / 0.02), 1e-7);
+  Image b = noisyImage(8, 8, 5);
+  EXPECT_THROW(relMse(a, b), InputError);
+  EXPECT_NEAR(meanRatio(std::vector<float>{2, 4}, std::vector<float>{1, 2}), 2.0, 1e-12);
+  EXPECT_EQ(meanRatio(std::vector<float>{0, 0}, std::vector<float>{0, 0}), 1.0);
+}
+
+TEST(Stats, ZTestPassesIndependentEstimatesOfTheSameImage) {
+  for (uint32_t seed = 0; seed < 4; ++seed) {
+    const Image a = noisyImage(64, 64, 10 + seed), b = noisyImage(64, 64, 20 + seed);
+    const ZTestResult r = zTest(a, b);
+    if (!r.pass) writeFailureImages(test::outputDir("stats_ztest_pass"), "same", a, b, r);
+    EXPECT_TRUE(r.pass) << r.summary();
+    EXPECT_EQ(r.tests, 3u * 64u * 64u);
+    EXPECT_NEAR(r.meanRatio, 1.0, 0.01);
+    EXPECT_LT(r.relMse, 1e-3);
+  }
+}
+
+TEST(Stats, ZTestFailsABiasOfAFewStandardErrorsInARegion) {
+  // a is biased by 5 of its standard errors in a 16x16 region: z ~ 5/sqrt(2) = 3.5 there,
+  // below the Šidák threshold (~4.9) for most single channels, yet the test must notice.
+  const Image a = noisyImage(64, 64, 30, 5.0, 16), b = noisyImage(64, 64, 40);
+  const ZTestResult r = zTest(a, b);
+  EXPECT_FALSE(r.pass) << r.summary();
+  EXPECT_GT(r.failingPixels, 0u);
+  EXPECT_LT(r.failingFraction, 16.0 * 16.0 / (64.0 * 64.0));
+  EXPECT_TRUE(r.worstX >= 8 && r.worstX < 24 && r.worstY >= 8 && r.worstY < 24) << r.summary();
+  EXPECT_GT(r.worstZ, 0.0);
+  // The failure report: both inputs, the z-scores and the summary.
+  const std::string dir = test::outputDir("stats_ztest_biased");
+  writeFailureImages(dir, "biased", a, b, r);
+  for (const char* f : {"biased_a.exr", "biased_b.exr", "biased_z.exr", "biased_summary.txt"}) {
+    EXPECT_TRUE(std::filesystem::exists(std::filesystem::path(dir) / f)) << f;
+  }
+  const Image z = readExr(dir + "/biased_z.exr");
+  EXPECT_EQ(z.rgb.size(), a.rgb.size());
+}
+
+TEST(Stats, ZTestAgainstExactValues) {
+  const int w = 32, h = 32;
+  std::vector<float> truth(size_t(3 * w * h));
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c) truth[size_t(3 * (y * w + x) + c)] = truthAt(x, y, c);
+  EXPECT_TRUE(zTestAgainst(noisyImage(w, h, 50), truth).pass);
+  const ZTestResult biased = zTestAgainst(noisyImage(w, h, 51, 6.0, 8), truth);
+  EXPECT_FALSE(biased.pass) << biased.summary();
+  // A constant: every pixel of a flat estimate around 0.5.
+  Image flat = noisyImage(w, h, 52);
+  RngState rng = shared::rng_init(glm::uvec2(0u, 0u), 0u, shared::RNG_STREAM_TEST, 43u);
+  for (size_t i = 0; i < flat.rgb.size(); ++i) {
+    const Estimate e = estimate(0.5f, kSamplesPerPixel, rng);
+    flat.rgb[i] = e.mean;
+    flat.var[i] = e.varianceOfMean;
+  }
+  EXPECT_TRUE(zTestAgainst(flat, glm::vec3(0.5f)).pass);
+  EXPECT_FALSE(zTestAgainst(flat, glm::vec3(0.5f, 0.5f, 0.52f)).pass);
+}
+
+TEST(Stats, ZTestZeroVarianceAndNonFinite) {
+  Image a;
+  a.width = 2;
+  a.height = 1;
+  a.rgb = {1.0f, 0.0f, 2.0f, 3.0f, 4.0f, 5.0f};
+  a.var.assign(6, 0.0f);
+  Image b = a;
+  EXPECT_TRUE(zTest(a, b).pass);  // exact matches where both variances are 0
+  b.rgb[2] = 2.0f * (1.0f + 1e-7f);
+  EXPECT_TRUE(zTest(a, b).pass);  // within the relative tolerance
+  b.rgb[2] = 2.001f;
+  ZTestResult r = zTest(a, b);
+  EXPECT_FALSE(r.pass);
+  EXPECT_EQ(r.failingPixels, 1u);
+  EXPECT_TRUE(std::isinf(r.worstZ));
+  EXPECT_EQ(r.worstX, 0);
+  EXPECT_EQ(r.worstChannel, 2);
+  b = a;
+  b.rgb[4] = std::numeric_limits<float>::quiet_NaN();
+  b.var[4] = 1.0f;
+  r = zTest(a, b);
+  EXPECT_FALSE(r.pass);
+  EXPECT_EQ(r.worstX, 1);
+}
+
+TEST(Stats, ZTestRefusesBadInput) {
+  Image a = noisyImage(8, 8, 60), b = noisyImage(8, 4, 61), c = noisyImage(8, 8, 62);
+  EXPECT_THROW(zTest(a, b), InputError);
+  c.var.clear();
+  EXPECT_THROW(zTest(a, c), InputError);
+  EXPECT_THROW(zTestAgainst(c, glm::vec3(1.0f)), InputError);
+  EXPECT_THROW(zTestAgainst(a, std::vector<float>(5)), InputError);
+}
