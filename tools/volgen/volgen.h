@@ -1,0 +1,66 @@
+// plume-volgen: makes the volumes bundled with Plume (volumes/README.md documents each one).
+// Everything here is deterministic: no unseeded randomness, no dependence on thread order (parallel
+// loops only write their own cells), and the VDB files' random archive UUID is replaced by one
+// derived from the file's contents, so the same command writes byte-identical files on every run.
+#pragma once
+
+#include <openvdb/openvdb.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace volgen {
+
+// --- Writing VDB files (vdb_io.cpp) ------------------------------------------------------------
+// Writes `grids` with BLOSC compression (optionally as half floats) and a content-derived UUID.
+// Throws std::runtime_error on failure.
+void writeVdb(const std::string& path, const openvdb::GridPtrVec& grids, bool halfFloat = false);
+// The same bytes as writeVdb would write, in memory.
+std::string vdbBytes(const openvdb::GridPtrVec& grids, bool halfFloat = false);
+// Writes raw bytes to a file (throws on failure).
+void writeBytes(const std::string& path, const std::string& bytes);
+// A linear transform: world = voxelSize * index + translation.
+openvdb::math::Transform::Ptr linearTransform(double voxelSize, const openvdb::Vec3d& translation);
+// "name: 12345 active voxels, 3 tiles, values [a, b], 12.3 kB" for the log.
+std::string describe(const std::string& path, const openvdb::FloatGrid& grid);
+
+// --- Deterministic noise (noise.cpp) -----------------------------------------------------------
+uint32_t hash32(uint32_t a, uint32_t b = 0, uint32_t c = 0, uint32_t d = 0);
+float hashUnit(uint32_t a, uint32_t b = 0, uint32_t c = 0, uint32_t d = 0);  // in [0, 1)
+// Smooth value noise in [-1, 1] on an integer lattice (period-free), and its fractal sum.
+float valueNoise(float x, float y, float z, uint32_t seed);
+float fbm(float x, float y, float z, int octaves, uint32_t seed);  // roughly in [-1, 1]
+
+// --- Subcommands -------------------------------------------------------------------------------
+struct SmokeParams {
+  std::string out = "volumes/smoke";
+  int frames = 24;
+  int res = 64;            // cells per axis; the domain is always 2 world units wide
+  int substeps = 2;        // solver steps per frame
+  int preroll = 12;        // frames simulated before frame 1
+  int pressureIters = 80;  // red-black SOR sweeps per step
+  float fps = 24.0f;
+  float buoyancy = 4.0f;   // world units/s² per unit temperature
+  float weight = 0.25f;    // world units/s² per unit density (pulls smoke down)
+  float cooling = 0.9f;    // 1/s, temperature decays as exp(-cooling t)
+  float vorticity = 10.0f; // vorticity confinement epsilon (Fedkiw et al. 2001 eq. 11, h = 1 cell)
+  uint32_t seed = 7;
+  bool halfFloat = false;
+};
+int runSmoke(const SmokeParams& p);
+
+int runProcedural(const std::string& outDir);
+int runBadInputs(const std::string& outDir);
+
+// An image of a grid for eyeballing: single scattering of a sun from `toLight`, orthographic
+// camera looking along -z (or -x), written as binary PGM.
+struct PreviewParams {
+  std::string in, out, grid = "density";
+  float densityScale = 10.0f;
+  char axis = 'z';
+  int box = 0;  // > 0: show index box [0, box-1]³ instead of the active bounding box
+};
+int runPreview(const PreviewParams& p);
+
+}  // namespace volgen
