@@ -11,16 +11,16 @@ const int VOL_BRICK = 8;
 const int VOL_TEXELS = 10;
 const uint VOL_MAX_STEPS = 1u << 20;  // per tracking call; hits are counted in volCounters[0]
 
-uint vol_slot(ivec3 brick) {
+// The indirection holds each brick's atlas slot as packed slot coordinates (10 bits per axis,
+// see GpuVolumeResources); 0 is the all-zero slot. No integer division in the hot loop.
+uint vol_packed_slot(ivec3 brick) {
   ivec3 r = brick - vol.brickOrigin.xyz;
   if (any(lessThan(r, ivec3(0))) || any(greaterThanEqual(r, vol.brickDims.xyz))) return 0u;
   return volIndirection[(r.z * vol.brickDims.y + r.y) * vol.brickDims.x + r.x];
 }
 
-ivec3 vol_slot_origin(uint slot) {
-  uint x = uint(vol.atlasSlots.x);
-  uint y = uint(vol.atlasSlots.y);
-  return ivec3(int(slot % x), int((slot / x) % y), int(slot / (x * y))) * VOL_TEXELS;
+ivec3 vol_slot_origin(uint packed) {
+  return ivec3(int(packed & 1023u), int((packed >> 10u) & 1023u), int(packed >> 20u)) * VOL_TEXELS;
 }
 
 // Density d at an index-space point (not yet multiplied by the density scale).
@@ -28,7 +28,7 @@ float vol_density(vec3 p) {
   vec3 fl = floor(p);
   ivec3 v = ivec3(fl);
   ivec3 b = v >> 3;
-  uint slot = vol_slot(b);
+  uint slot = vol_packed_slot(b);
   if (slot == 0u) return 0.0f;
   vec3 f = p - fl;
   ivec3 t = vol_slot_origin(slot) + (v - b * VOL_BRICK) + 1;
@@ -82,9 +82,10 @@ bool vol_sample_collision(vec3 oWorld, vec3 dWorld, float tMax, inout RngState r
         atomicAdd(volCounters[0], 1u);
         return false;
       }
-      t -= log(1.0f - rng_float(rng)) / maj;
+      vec2 u = rng_float2(rng);
+      t -= log(1.0f - u.x) / maj;
       if (t >= b) break;
-      if (rng_float(rng) * maj < vol_sigma_t(o + t * d)) {
+      if (u.y * maj < vol_sigma_t(o + t * d)) {
         tHit = t;
         return true;
       }

@@ -40,8 +40,17 @@ GpuVolumeResources::GpuVolumeResources(gpu::Context& ctx, const BakedVolume& bak
   const size_t atlasBytes = f16 ? bake.atlasF16.size() * 2 : bake.atlasF32.size() * 4;
   atlas_.upload(f16 ? (const void*)bake.atlasF16.data() : (const void*)bake.atlasF32.data(), atlasBytes);
 
-  indirection_ = gpu::Buffer(ctx, bake.indirection.size() * 4, storage, "brick indirection");
-  indirection_.upload(bake.indirection.data(), bake.indirection.size() * 4);
+  // Slot indices become packed slot coordinates (x | y << 10 | z << 20): no division in shaders.
+  if (glm::any(glm::greaterThan(bake.atlasSlots, glm::ivec3(1024)))) {
+    throw DeviceError("bake: more than 1024 atlas slots per axis");
+  }
+  std::vector<uint32_t> packed(bake.indirection.size());
+  for (size_t i = 0; i < packed.size(); ++i) {
+    const glm::ivec3 o = slotTexelOrigin(bake, bake.indirection[i]) / kBrickTexels;
+    packed[i] = uint32_t(o.x) | uint32_t(o.y) << 10 | uint32_t(o.z) << 20;
+  }
+  indirection_ = gpu::Buffer(ctx, packed.size() * 4, storage, "brick indirection");
+  indirection_.upload(packed.data(), packed.size() * 4);
   majorants_ = gpu::Buffer(ctx, majorants.size() * 4, storage, "majorant hierarchy");
   majorants_.upload(majorants.data(), majorants.size() * 4);
   counters_ = gpu::Buffer(ctx, 16, storage, "tracking counters");
