@@ -268,6 +268,7 @@ Image renderReference(const Scene& scene, openvdb::FloatGrid::ConstPtr density,
   image.meta["wall_time_s"] = strf("%.3f", seconds);
   image.meta["samples_per_s"] = strf("%.0f", stats.samplesPerSecond());
   image.meta["tracking_truncated"] = std::to_string(stats.truncatedTracking);
+  image.meta["tracking_steps"] = std::to_string(stats.trackingSteps);
   image.meta["device"] = "cpu-reference";
   if (statsOut) *statsOut = stats;
   return image;
