@@ -46,7 +46,7 @@ Image renderReference(Scene s, openvdb::FloatGrid::Ptr grid, int spp) {
 }
 
 // Renders on the GPU and with the reference; the Z-test must pass and the means agree.
-void expectMatchesReference(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene,
+Image expectMatchesReference(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene,
                             openvdb::FloatGrid::Ptr grid, int gpuSpp, int refSpp, const std::string& name,
                             std::string* variant = nullptr) {
   Scene s = scene;
@@ -60,6 +60,15 @@ void expectMatchesReference(gpu::Context& ctx, gpu::ShaderCompiler& compiler, co
   EXPECT_EQ(info.truncated, 0u) << name;
   if (!z.pass) writeFailureImages(test::outputDir("gpu_pt"), name, gpuImage, refImage, z);
   if (variant) *variant = info.variant;
+  return gpuImage;
+}
+
+// Pixels whose value differs from the background (the camera ray hit the medium).
+int pixelsShowingMedium(const Image& img, glm::vec3 background) {
+  int n = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) n += glm::any(glm::greaterThan(glm::abs(img.pixel(x, y) - background), glm::vec3(1e-4f)));
+  return n;
 }
 
 }  // namespace
@@ -125,4 +134,21 @@ TEST_F(GpuPathTracer, FeatureSetsCompileDifferentVariantsAndBothMatch) {
   EXPECT_EQ(v2, "sun+env+multi");
   EXPECT_EQ(compiler().compiles() - compilesBefore, 2u);
   EXPECT_NE(featuresOf(single).defines(), featuresOf(multi).defines());
+}
+
+TEST_F(GpuPathTracer, SparseVolumeSkipsEmptySpaceCorrectly) {
+  // Two noise blobs 180 voxels apart along x: the walk crosses empty level-1 cells between them.
+  auto grid = test::makeNoiseGrid(20, 1.0 / 40, 9);
+  auto far = test::makeNoiseGrid(20, 1.0 / 40, 11);
+  far->transform().postTranslate(openvdb::Vec3d(0));  // same transform; move the voxels instead
+  auto acc = grid->getAccessor();
+  for (auto it = far->cbeginValueOn(); it; ++it) acc.setValue(it.getCoord() + openvdb::Coord(180, 6, 0), *it);
+  Scene s = baseScene({-1.5f, 0.4f, 0.25f}, {3.0f, 0.3f, 0.25f}, 20);
+  s.camera.base.fovY = 25.0f;
+  s.media[0].densityScale = 12.0f;
+  s.media[0].albedo = glm::vec3(0.85f);
+  s.render.maxBounces = 4;
+  Image img = expectMatchesReference(ctx(), compiler(), s, grid, 256, 512, "sparse");
+  // The medium is in view (rays through the near blob go on across the empty cells to the far one).
+  EXPECT_GT(pixelsShowingMedium(img, s.lights[1].radiance), 40);
 }

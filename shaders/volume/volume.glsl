@@ -1,6 +1,7 @@
 // The bridge between the tracking algorithms and the baked volume: trilinear density with
 // exact weights (8 texelFetch, DESIGN §3), per-brick majorants, delta tracking and ratio
-// tracking. Mirrors media/bake_lookup.cpp texel for texel. Requires bindings.glsl.
+// tracking over the majorant hierarchy. Mirrors media/bake_lookup.cpp texel for texel.
+// Requires bindings.glsl.
 #ifndef PLUME_VOLUME_GLSL
 #define PLUME_VOLUME_GLSL
 
@@ -55,10 +56,62 @@ void vol_ray_to_index(vec3 oWorld, vec3 dWorld, out vec3 o, out vec3 d) {
   d = (vol.worldToIndex * vec4(dWorld, 0.0f)).xyz;
 }
 
-bool vol_start(vec3 o, vec3 d, float tMax, out DdaState s) {
+// Empty-space skipping over the majorant hierarchy: an outer DDA over level-1 cells (4³
+// bricks) skips cells whose max is 0; inside a non-empty one an inner DDA walks its bricks and
+// yields [a, b) segments with the brick's majorant. Volumes with a single level walk bricks only.
+struct VolWalk {
+  DdaState outer;
+  DdaState inner;
+  ivec3 outerCell;
+  bool innerLive;
+  bool twoLevel;
+  vec3 o;
+  vec3 d;
+};
+
+float vol_level_max(int level, ivec3 cell) {
+  ivec3 dims = vol.levelDims[level].xyz;
+  return volMajorants[vol.levelOffset[level] + uint((cell.z * dims.y + cell.y) * dims.x + cell.x)];
+}
+
+bool vol_walk_start(out VolWalk w, vec3 o, vec3 d, float tMax) {
+  w.o = o;
+  w.d = d;
+  w.outerCell = ivec3(0);
+  w.twoLevel = vol.info.x >= 2u;
+  w.innerLive = false;
   if (vol.brickDims.w != 0) return false;  // empty volume
-  return dda_init(s, o, d, 0.0f, tMax, vec3(vol.brickOrigin.xyz * VOL_BRICK), float(VOL_BRICK),
-                  vol.levelDims[0].xyz);
+  vec3 origin = vec3(vol.brickOrigin.xyz * VOL_BRICK);
+  if (w.twoLevel) {
+    return dda_init(w.outer, o, d, 0.0f, tMax, origin, float(VOL_BRICK * vol.levelDims[1].w), vol.levelDims[1].xyz);
+  }
+  w.innerLive = dda_init(w.inner, o, d, 0.0f, tMax, origin, float(VOL_BRICK), vol.levelDims[0].xyz);
+  return w.innerLive;
+}
+
+// The next majorant segment [a, b) with sigma_t majorant `maj` (possibly 0); false at the end.
+bool vol_walk_next(inout VolWalk w, out float a, out float b, out float maj) {
+  maj = 0.0f;
+  for (;;) {
+    ivec3 sub;
+    if (w.innerLive) {
+      if (dda_next(w.inner, a, b, sub)) {
+        maj = vol_brick_majorant(w.outerCell * vol.levelDims[1].w + sub);
+        return true;
+      }
+      w.innerLive = false;
+    }
+    if (!w.twoLevel) return false;
+    ivec3 cell;
+    if (!dda_next(w.outer, a, b, cell)) return false;
+    if (vol_level_max(1, cell) <= 0.0f) continue;
+    int n = vol.levelDims[1].w;  // bricks per level-1 cell edge
+    w.outerCell = cell;
+    ivec3 dims = min(ivec3(n), vol.levelDims[0].xyz - cell * n);
+    vec3 origin = vec3((vol.brickOrigin.xyz + cell * n) * VOL_BRICK);
+    w.innerLive = dda_init(w.inner, w.o, w.d, a, b, origin, float(VOL_BRICK), dims);
+  }
+  return false;
 }
 
 // Delta tracking (Woodcock): the first real collision along the world ray in (0, tMax).
@@ -67,14 +120,13 @@ bool vol_sample_collision(vec3 oWorld, vec3 dWorld, float tMax, inout RngState r
   vec3 o;
   vec3 d;
   vol_ray_to_index(oWorld, dWorld, o, d);
-  DdaState s;
-  if (!vol_start(o, d, tMax, s)) return false;
+  VolWalk walk;
+  if (!vol_walk_start(walk, o, d, tMax)) return false;
   uint steps = 0u;
   float a;
   float b;
-  ivec3 cell;
-  while (dda_next(s, a, b, cell)) {
-    float maj = vol_brick_majorant(cell);
+  float maj;
+  while (vol_walk_next(walk, a, b, maj)) {
     if (maj <= 0.0f) continue;
     float t = a;  // exponential steps are memoryless: restart at the segment's entry
     for (;;) {
@@ -99,15 +151,14 @@ float vol_ratio_tracking(vec3 oWorld, vec3 dWorld, float tMax, inout RngState rn
   vec3 o;
   vec3 d;
   vol_ray_to_index(oWorld, dWorld, o, d);
-  DdaState s;
-  if (!vol_start(o, d, tMax, s)) return 1.0f;
+  VolWalk walk;
+  if (!vol_walk_start(walk, o, d, tMax)) return 1.0f;
   uint steps = 0u;
   float tr = 1.0f;
   float a;
   float b;
-  ivec3 cell;
-  while (tr > 0.0f && dda_next(s, a, b, cell)) {
-    float maj = vol_brick_majorant(cell);
+  float maj;
+  while (tr > 0.0f && vol_walk_next(walk, a, b, maj)) {
     if (maj <= 0.0f) continue;
     float t = a;
     for (;;) {
