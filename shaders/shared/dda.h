@@ -60,20 +60,21 @@ PLUME_FN bool dda_init(OUT(DdaState) s, vec3 o, vec3 d, float tMin, float tMax, 
   return true;
 }
 
-// The next segment [t0, t1) and its cell; false when the ray has left the grid.
+// The next segment [t0, t1) and its cell; false when the ray has left the grid. Written with
+// component masks instead of a dynamically indexed axis: SIMD back ends (lavapipe) handle a
+// per-lane vector index poorly. Axes that tie step together (the ray crosses an edge).
 PLUME_FN bool dda_next(INOUT(DdaState) s, OUT(float) t0, OUT(float) t1, OUT(ivec3) cell) {
   cell = s.cell;
   t0 = s.t;
   t1 = s.t;
   if (!(s.t < s.tEnd)) return false;
-  int axis = 0;
-  if (s.tNext.y < s.tNext[axis]) axis = 1;
-  if (s.tNext.z < s.tNext[axis]) axis = 2;
-  t1 = min(s.tNext[axis], s.tEnd);
+  float tMin = min(s.tNext.x, min(s.tNext.y, s.tNext.z));
+  vec3 stepMask = vec3(equal(s.tNext, vec3(tMin)));
+  t1 = min(tMin, s.tEnd);
   s.t = t1;
-  s.cell[axis] += s.stepDir[axis];
-  s.tNext[axis] += s.tDelta[axis];
-  if (s.cell[axis] < 0 || s.cell[axis] >= s.dims[axis]) s.t = s.tEnd;
+  s.cell += ivec3(stepMask) * s.stepDir;
+  s.tNext += stepMask * s.tDelta;
+  if (any(lessThan(s.cell, ivec3(0))) || any(greaterThanEqual(s.cell, s.dims))) s.t = s.tEnd;
   return true;
 }
 

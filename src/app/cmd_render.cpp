@@ -4,17 +4,19 @@
 #include "app/settings_cli.h"
 #include "core/error.h"
 #include "core/log.h"
-#include "core/progress.h"
 #include "gpu/context.h"
 #include "gpu/shader_compiler.h"
 #include "media/bake.h"
 #include "media/vdb_loader.h"
 #include "render/gpu_volume.h"
 #include "render/path_tracer.h"
+#include "render/restir.h"
 #include "scene/scene.h"
 
 #include <chrono>
 #include <memory>
+#include <utility>
+#include <vector>
 
 namespace plume {
 namespace {
@@ -25,6 +27,7 @@ struct RenderArgs {
   bool quiet = false;
   int width = 0, height = 0;
   int batch = 4;
+  int preroll = 0;
   std::string device;
   std::string texels = "float16";
   SettingOverrides overrides;
@@ -36,6 +39,71 @@ std::string passTimesText(const PassTimes& times) {
   return s;
 }
 
+// Estimators that carry state from frame to frame (temporal reuse) want a few earlier frames
+// rendered, not written, when a chunk starts mid-sequence (DESIGN §8). The path tracer's frames
+// are independent: nothing to warm.
+bool carriesHistory(const std::string& mode) { return mode == "restir" || mode == "restir-biased"; }
+
+// The frames to warm up before `first`: up to K earlier frames, not before the animation's
+// first frame (the scene file's render.frames[0], where the VDB sequence starts).
+std::pair<int, int> prerollRange(const Scene& scene, int preroll) {
+  const int first = scene.render.frameFirst;
+  if (preroll <= 0 || !carriesHistory(scene.render.mode)) return {first, first - 1};
+  return {std::max(scene.camera.baseFrame, first - preroll), first - 1};
+}
+
+// ReSTIR frames: `spp` ReSTIR iterations per frame (one sample per pixel each), history kept
+// across iterations and frames; mean and variance of the iterations (correlated by reuse, so the
+// variance is a rough guide only).
+int runRestirRender(const RenderArgs& a, const Scene& scene) {
+  const RenderSettings& rs = scene.render;
+  a.outputs.check(rs);
+  BakeOptions bakeOptions;
+  bakeOptions.format = a.texels == "float32" ? TexelFormat::Float32 : TexelFormat::Float16;
+  gpu::Context ctx({a.device, false, !a.quiet});
+  gpu::ShaderCompiler compiler({}, gpu::ShaderCompiler::defaultCacheDir());
+  Restir restir(ctx, compiler, scene, restirOptionsOf(rs));
+  const Medium& medium = scene.media.at(0);
+  std::unique_ptr<GpuVolumeResources> prev;
+  for (int frame = rs.frameFirst; frame <= rs.frameLast; ++frame) {
+    const auto start = std::chrono::steady_clock::now();
+    LoadedGrid grid = loadFloatGrid(medium.vdbPath(frame), medium.densityGrid);
+    auto volume = std::make_unique<GpuVolumeResources>(ctx, bakeVolume(grid, bakeOptions), medium.densityScale);
+    restir.setVolumes(*volume, prev ? *prev : *volume);
+    Image sum(scene.camera.width, scene.camera.height, true);
+    std::vector<double> s1(sum.rgb.size(), 0.0), s2(sum.rgb.size(), 0.0);
+    uint32_t dropped = 0;
+    for (int i = 0; i < rs.spp; ++i) {
+      if (i == 1) restir.setVolumes(*volume, *volume);
+      Image im = restir.renderFrame(frame, 0, uint32_t(i));
+      dropped += restir.lastDroppedCount();
+      for (size_t k = 0; k < im.rgb.size(); ++k) s1[k] += im.rgb[k], s2[k] += double(im.rgb[k]) * im.rgb[k];
+    }
+    const double n = rs.spp;
+    for (size_t k = 0; k < s1.size(); ++k) {
+      sum.rgb[k] = float(s1[k] / n);
+      sum.var[k] = n > 1 ? float(std::max(0.0, s2[k] / n - (s1[k] / n) * (s1[k] / n)) / (n - 1)) : 0.0f;
+    }
+    prev = std::move(volume);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    sum.meta["version"] = PLUME_VERSION;
+    sum.meta["mode"] = rs.mode;
+    sum.meta["restir"] = restir.options().name();
+    sum.meta["spp"] = std::to_string(rs.spp);
+    sum.meta["seed"] = std::to_string(rs.seed);
+    sum.meta["frame"] = std::to_string(frame);
+    sum.meta["device"] = ctx.deviceName();
+    sum.meta["wall_time_s"] = strf("%.3f", seconds);
+    sum.meta["pass_times_last_iteration"] = passTimesText(restir.lastPassTimes());
+    sum.meta["dropped_non_finite_reservoirs"] = std::to_string(dropped);
+    sum.meta["scene"] = a.scene;
+    a.outputs.write(frame, sum);
+    if (!a.quiet) logInfo(strf("frame %d: %s  %.2fs (%s; dropped %u)", frame, a.outputs.exrPath(frame).c_str(), seconds,
+                               passTimesText(restir.lastPassTimes()).c_str(), dropped));
+  }
+  return kExitOk;
+}
+
 int runRender(const RenderArgs& a) {
   setQuiet(a.quiet);
   Scene scene = loadScene(a.scene);
@@ -43,9 +111,11 @@ int runRender(const RenderArgs& a) {
   if (a.width > 0) scene.camera.width = a.width;
   if (a.height > 0) scene.camera.height = a.height;
   const RenderSettings& rs = scene.render;
-  if (rs.mode != "pt") {
-    throw InputError(scene.path + ": render.mode: \"" + rs.mode + "\" is not implemented yet; use \"pt\"");
+  if (a.preroll > 0 && !carriesHistory(rs.mode)) {
+    logInfo(strf("--preroll %d: no effect with mode %s (its frames are independent)", a.preroll, rs.mode.c_str()));
   }
+  // Mode dispatch: the one place that picks the estimator (today only the path tracer).
+  if (rs.mode != "pt") return runRestirRender(a, scene);  // restir, restir-biased (render/restir.h)
   a.outputs.check(rs);
   BakeOptions bakeOptions;
   bakeOptions.format = a.texels == "float32" ? TexelFormat::Float32 : TexelFormat::Float16;
@@ -54,15 +124,19 @@ int runRender(const RenderArgs& a) {
   gpu::ShaderCompiler compiler({}, gpu::ShaderCompiler::defaultCacheDir());
   PathTracer tracer(ctx, compiler, scene);
   const Medium& medium = scene.media.at(0);
-  const int frames = rs.frameLast - rs.frameFirst + 1;
-  std::unique_ptr<ProgressBar> bar;
-  if (!a.quiet) bar = std::make_unique<ProgressBar>("render", uint64_t(frames) * uint64_t(rs.spp));
+  std::vector<int> todo;  // frames not already complete (--resume)
   for (int frame = rs.frameFirst; frame <= rs.frameLast; ++frame) {
-    if (a.outputs.skip(frame, rs)) {
-      if (bar) bar->advance(uint64_t(rs.spp));
-      continue;
-    }
+    if (!a.outputs.skip(frame, rs)) todo.push_back(frame);
+  }
+  const int toRender = int(todo.size());
+  FrameProgress progress(toRender, rs.spp, !a.quiet);
+  // Pre-roll hook: frames [first, last] of prerollRange are to be rendered into the estimator's
+  // history and not written; empty for the path tracer.
+  const auto [prerollFirst, prerollLast] = prerollRange(scene, a.preroll);
+  if (prerollLast >= prerollFirst) logInfo(strf("pre-roll: frames %d-%d", prerollFirst, prerollLast));
+  for (int frame : todo) {
     const auto start = std::chrono::steady_clock::now();
+    progress.beginFrame(frame);
     LoadedGrid grid = loadFloatGrid(medium.vdbPath(frame), medium.densityGrid);
     BakedVolume bake = bakeVolume(grid, bakeOptions);
     GpuVolumeResources volume(ctx, bake, medium.densityScale);
@@ -72,7 +146,7 @@ int runRender(const RenderArgs& a) {
       const int n = std::min(a.batch, rs.spp - done);
       tracer.addSamples(n);
       done += n;
-      if (bar) bar->advance(uint64_t(n));
+      progress.samplesDone(n);
     }
     Image image = tracer.readImage();
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -85,7 +159,7 @@ int runRender(const RenderArgs& a) {
     image.meta["frame"] = std::to_string(frame);
     image.meta["max_bounces"] = std::to_string(rs.maxBounces);
     image.meta["device"] = ctx.deviceName();
-    image.meta["variant"] = tracer.features().name();
+    image.meta["variant"] = tracer.variantName();
     image.meta["texels"] = texelFormatName(bake.format);
     image.meta["wall_time_s"] = strf("%.3f", seconds);
     image.meta["pass_times_last_batch"] = passTimesText(tracer.lastPassTimes());
@@ -93,11 +167,9 @@ int runRender(const RenderArgs& a) {
     image.meta["replaced_values"] = std::to_string(grid.replacedValues);
     image.meta["scene"] = a.scene;
     a.outputs.write(frame, image);
-    if (a.quiet) continue;
-    logInfo(strf("frame %d: %s  %.2fs (%s)", frame, a.outputs.exrPath(frame).c_str(), seconds,
-                 passTimesText(tracer.lastPassTimes()).c_str()));
+    progress.frameDone(frame, a.outputs.exrPath(frame), seconds, passTimesText(tracer.lastPassTimes()));
   }
-  if (bar) bar->finish();
+  progress.finish();
   return kExitOk;
 }
 
@@ -114,6 +186,10 @@ void addRenderCommand(CLI::App& app, Action& action) {
   cmd->add_option("--width", args->width, "override camera.width")->check(CLI::Range(1, 16384));
   cmd->add_option("--height", args->height, "override camera.height")->check(CLI::Range(1, 16384));
   cmd->add_option("--batch", args->batch, "samples per pixel per dispatch")->check(CLI::Range(1, 4096));
+  cmd->add_option("--preroll", args->preroll,
+                  "warm temporal reuse on up to K frames before the first one (not written; for chunks that start "
+                  "mid-sequence). No effect with --mode pt, whose frames are independent")
+      ->check(CLI::Range(0, 1000));
   cmd->add_option("--device", args->device, "Vulkan device to use (substring of its name)");
   cmd->add_option("--texels", args->texels, "brick atlas storage: float16 (default) or float32")
       ->check(CLI::IsMember({"float16", "float32"}));

@@ -5,7 +5,12 @@
 #include "core/log.h"
 #include "scene/scene.h"
 
+#include <algorithm>
+#include <cerrno>
+#include <csignal>
+#include <cstdio>
 #include <filesystem>
+#include <unistd.h>
 
 namespace plume {
 
@@ -41,10 +46,99 @@ bool FrameOutputs::skip(int frame, const RenderSettings& rs) const {
   return false;
 }
 
+namespace {
+
+// AtomicFile names its temporary ".<name>.tmp<pid>" beside the target (core/atomic_file.cpp).
+void removeStaleTemporaries(const std::string& target) {
+  namespace fs = std::filesystem;
+  const fs::path p(target);
+  const fs::path dir = p.parent_path().empty() ? fs::path(".") : p.parent_path();
+  const std::string prefix = "." + p.filename().string() + ".tmp";
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind(prefix, 0) != 0) continue;
+    const std::string digits = name.substr(prefix.size());
+    if (digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos) continue;
+    const pid_t pid = pid_t(std::stol(digits));
+    const bool alive = pid == getpid() || ::kill(pid, 0) == 0 || errno == EPERM;
+    const auto age = fs::file_time_type::clock::now() - fs::last_write_time(entry.path(), ec);
+    if (!alive && !ec && age > std::chrono::minutes(1)) {
+      fs::remove(entry.path(), ec);
+      if (!ec) logInfo("removed " + entry.path().string() + " (left by an interrupted run)");
+    }
+  }
+}
+
+}  // namespace
+
 void FrameOutputs::write(int frame, const Image& image) const {
+  removeStaleTemporaries(exrPath(frame));
+  if (png) removeStaleTemporaries(pngPath(frame));
   // The PNG first: the EXR's presence marks the frame complete for --resume.
   if (png) writePng(pngPath(frame), image);
   writeExr(exrPath(frame), image);
+}
+
+FrameProgress::FrameProgress(int framesToRender, int sppPerFrame, bool enabled)
+    : total_(std::max(0, framesToRender)), spp_(std::max(1, sppPerFrame)), enabled_(enabled),
+      tty_(isatty(STDERR_FILENO) != 0), start_(std::chrono::steady_clock::now()), frameStart_(start_), lastDraw_(start_) {}
+
+void FrameProgress::beginFrame(int frame) {
+  frame_ = frame;
+  samples_ = 0;
+  frameStart_ = std::chrono::steady_clock::now();
+  if (enabled_ && tty_) drawBar();
+}
+
+void FrameProgress::samplesDone(int n) {
+  samples_ += n;
+  const auto now = std::chrono::steady_clock::now();
+  if (!enabled_ || !tty_ || now - lastDraw_ < std::chrono::milliseconds(100)) return;
+  lastDraw_ = now;
+  drawBar();
+}
+
+double FrameProgress::etaSeconds() const {
+  // Remaining frames at the mean time per finished frame (the current frame's elapsed time
+  // stands in before one has finished), minus the current frame's part already done.
+  const double inFrame = std::chrono::duration<double>(std::chrono::steady_clock::now() - frameStart_).count();
+  const double frac = std::min(1.0, double(samples_) / double(spp_));
+  double perFrame = done_ > 0 ? sumSeconds_ / done_ : (frac > 0 ? inFrame / frac : 0.0);
+  return std::max(0.0, perFrame * (total_ - done_) - (done_ > 0 ? perFrame * frac : inFrame));
+}
+
+void FrameProgress::drawBar() {
+  const double frac = total_ > 0 ? std::min(1.0, (done_ + std::min(1.0, double(samples_) / spp_)) / total_) : 1.0;
+  const int width = 24;
+  std::string bar(size_t(frac * width), '#');
+  bar.resize(width, '-');
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  std::string times = done_ > 0 ? strf("last %.2fs/frame, mean %.2fs", lastSeconds_, sumSeconds_ / done_) : "";
+  std::fprintf(stderr, "\r\033[Krender [%s] %d/%d frames  frame %d  %s  elapsed %.1fs  eta %.1fs", bar.c_str(), done_,
+               total_, frame_, times.c_str(), elapsed, etaSeconds());
+  std::fflush(stderr);
+}
+
+void FrameProgress::frameDone(int frame, const std::string& path, double seconds, const std::string& detail) {
+  ++done_;
+  sumSeconds_ += seconds;
+  lastSeconds_ = seconds;
+  samples_ = 0;
+  frameStart_ = std::chrono::steady_clock::now();
+  if (!enabled_) return;
+  if (tty_) std::fprintf(stderr, "\r\033[K");  // the log line replaces the bar, which is redrawn below it
+  logInfo(strf("frame %d (%d/%d): %s  %.2fs  eta %.1fs%s", frame, done_, total_, path.c_str(), seconds,
+               etaSeconds(), detail.empty() ? "" : ("  (" + detail + ")").c_str()));
+  if (tty_ && done_ < total_) drawBar();
+}
+
+void FrameProgress::finish() {
+  if (!enabled_) return;
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  if (tty_) std::fprintf(stderr, "\r\033[K");
+  logInfo(strf("rendered %d frame%s in %.1fs%s", done_, done_ == 1 ? "" : "s", elapsed,
+               done_ > 0 ? strf(" (%.2fs/frame)", sumSeconds_ / done_).c_str() : ""));
 }
 
 }  // namespace plume

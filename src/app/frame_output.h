@@ -1,11 +1,14 @@
 // Output handling shared by `plume reference` and `plume render`: frame patterns, up-front
 // writability checks, resume (a frame is complete when its EXR reads back with the same
-// settings in its header), EXR + optional PNG written atomically.
+// settings in its header), EXR + optional PNG written atomically; and the progress display of a
+// frame sequence (bar with per-frame time and ETA on a terminal, one log line per frame otherwise).
 #pragma once
 
 #include "io/image.h"
 #include "scene/settings.h"
 
+#include <chrono>
+#include <cstdint>
 #include <string>
 
 namespace plume {
@@ -21,7 +24,31 @@ struct FrameOutputs {
   std::string pngPath(int frame) const;
   // --resume and the frame's EXR is complete for these settings (mode, spp, seed).
   bool skip(int frame, const RenderSettings& rs) const;
+  // Atomic writes; first removes temporaries of this frame's files left by a killed run (a
+  // process that no longer exists on this host, untouched for a minute).
   void write(int frame, const Image& image) const;
+};
+
+// Progress over the frames a run renders (skipped ones are counted out up front): on a terminal
+// a bar redrawn as samples complete with the last frame's time, the mean and the ETA; otherwise
+// (logs, farm jobs) one plain line per finished frame with the same numbers.
+class FrameProgress {
+ public:
+  FrameProgress(int framesToRender, int sppPerFrame, bool enabled);
+  void beginFrame(int frame);
+  void samplesDone(int n);
+  void frameDone(int frame, const std::string& path, double seconds, const std::string& detail);
+  void finish();
+
+ private:
+  void drawBar();
+  double etaSeconds() const;
+
+  int total_, spp_;
+  bool enabled_, tty_;
+  int done_ = 0, frame_ = 0, samples_ = 0;
+  double sumSeconds_ = 0, lastSeconds_ = 0;
+  std::chrono::steady_clock::time_point start_, frameStart_, lastDraw_;
 };
 
 }  // namespace plume

@@ -12,8 +12,10 @@ int main(int argc, char** argv) {
   Action action;
   addInfoCommand(app, action);
   addRenderCommand(app, action);
+  addViewCommand(app, action);
   addReferenceCommand(app, action);
   addCompareCommand(app, action);
+  addBenchCommand(app, action);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -52,7 +52,7 @@ int typeRank(VkPhysicalDeviceType t) {
   }
 }
 
-VkInstance createInstance(bool validation) {
+VkInstance createInstance(bool validation, const std::vector<std::string>& extraExtensions = {}) {
   VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
   app.pApplicationName = "plume";
   app.apiVersion = VK_API_VERSION_1_2;
@@ -61,6 +61,7 @@ VkInstance createInstance(bool validation) {
     layers.push_back(kValidationLayer);
     extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
   }
+  for (const std::string& e : extraExtensions) extensions.push_back(e.c_str());
   VkInstanceCreateInfo ci{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
   ci.pApplicationInfo = &app;
   ci.enabledLayerCount = uint32_t(layers.size());
@@ -84,15 +85,31 @@ std::vector<VkPhysicalDevice> physicalDevices(VkInstance instance) {
   return devices;
 }
 
-int computeQueueFamily(VkPhysicalDevice d) {
+// A queue family with compute; with a surface, one that also has graphics (UI drawing) and can
+// present to it, so that one queue serves the whole frame.
+int computeQueueFamily(VkPhysicalDevice d, VkSurfaceKHR surface = VK_NULL_HANDLE) {
   uint32_t n = 0;
   vkGetPhysicalDeviceQueueFamilyProperties(d, &n, nullptr);
   std::vector<VkQueueFamilyProperties> families(n);
   vkGetPhysicalDeviceQueueFamilyProperties(d, &n, families.data());
   for (uint32_t i = 0; i < n; ++i) {
-    if (families[i].queueFlags & VK_QUEUE_COMPUTE_BIT) return int(i);
+    if (!(families[i].queueFlags & VK_QUEUE_COMPUTE_BIT)) continue;
+    if (surface) {
+      VkBool32 present = VK_FALSE;
+      if (vkGetPhysicalDeviceSurfaceSupportKHR(d, i, surface, &present) != VK_SUCCESS || !present) continue;
+      if (!(families[i].queueFlags & VK_QUEUE_GRAPHICS_BIT)) continue;
+    }
+    return int(i);
   }
   return -1;
+}
+
+bool hasDeviceExtension(VkPhysicalDevice d, const char* name) {
+  uint32_t n = 0;
+  vkEnumerateDeviceExtensionProperties(d, nullptr, &n, nullptr);
+  std::vector<VkExtensionProperties> exts(n);
+  vkEnumerateDeviceExtensionProperties(d, nullptr, &n, exts.data());
+  return std::any_of(exts.begin(), exts.end(), [&](const auto& e) { return std::strcmp(e.extensionName, name) == 0; });
 }
 
 }  // namespace
@@ -119,7 +136,7 @@ Context::Context(const ContextOptions& options) {
   if (validation_ && !layerAvailable(kValidationLayer)) {
     throw DeviceError(std::string(kValidationLayer) + " requested but not installed (vulkan-validationlayers)");
   }
-  instance_ = createInstance(validation_);
+  instance_ = createInstance(validation_, options.instanceExtensions);
   if (validation_) {
     auto create = (PFN_vkCreateDebugUtilsMessengerEXT)vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT");
     VkDebugUtilsMessengerCreateInfoEXT mi{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
@@ -130,6 +147,18 @@ Context::Context(const ContextOptions& options) {
     mi.pUserData = this;
     if (create) PLUME_VK(create(instance_, &mi, nullptr, &messenger_));
   }
+  if (options.createSurface) {
+    try {
+      surface_ = options.createSurface(instance_);
+    } catch (...) {
+      release();
+      throw;
+    }
+    if (!surface_) {
+      release();
+      throw DeviceError("no window surface could be created");
+    }
+  }
 
   // Choose: the named device, else the best-ranked type that has a compute queue.
   std::vector<VkPhysicalDevice> devices = physicalDevices(instance_);
@@ -139,7 +168,8 @@ Context::Context(const ContextOptions& options) {
     VkPhysicalDeviceProperties p;
     vkGetPhysicalDeviceProperties(d, &p);
     available += std::string(available.empty() ? "" : ", ") + p.deviceName;
-    if (computeQueueFamily(d) < 0) continue;
+    if (computeQueueFamily(d, surface_) < 0) continue;
+    if (surface_ && !hasDeviceExtension(d, VK_KHR_SWAPCHAIN_EXTENSION_NAME)) continue;
     if (!options.deviceName.empty()) {
       if (lower(p.deviceName).find(lower(options.deviceName)) == std::string::npos) continue;
     }
@@ -151,12 +181,13 @@ Context::Context(const ContextOptions& options) {
   if (!physical_) {
     std::string what = options.deviceName.empty() ? "no Vulkan device with a compute queue"
                                                   : "no Vulkan device matches \"" + options.deviceName + "\"";
+    if (surface_) what += " that can present to the window (compute + graphics + present, VK_KHR_swapchain)";
     release();
     throw DeviceError(what + " (devices: " + (available.empty() ? "none" : available) + ")");
   }
   vkGetPhysicalDeviceProperties(physical_, &props_);
   vkGetPhysicalDeviceMemoryProperties(physical_, &memProps_);
-  queueFamily_ = uint32_t(computeQueueFamily(physical_));
+  queueFamily_ = uint32_t(computeQueueFamily(physical_, surface_));
   if (options.verbose) logInfo(strf("device: %s%s", props_.deviceName, validation_ ? " (validation on)" : ""));
 
   float priority = 1.0f;
@@ -169,6 +200,11 @@ Context::Context(const ContextOptions& options) {
   di.queueCreateInfoCount = 1;
   di.pQueueCreateInfos = &qi;
   di.pEnabledFeatures = &features;
+  const char* swapchainExt = VK_KHR_SWAPCHAIN_EXTENSION_NAME;
+  if (surface_) {
+    di.enabledExtensionCount = 1;
+    di.ppEnabledExtensionNames = &swapchainExt;
+  }
   PLUME_VK(vkCreateDevice(physical_, &di, nullptr, &device_));
   vkGetDeviceQueue(device_, queueFamily_, 0, &queue_);
   VkCommandPoolCreateInfo pi{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
@@ -188,6 +224,10 @@ void Context::release() {
     if (pool_) vkDestroyCommandPool(device_, pool_, nullptr);
     vkDestroyDevice(device_, nullptr);
     device_ = VK_NULL_HANDLE;
+  }
+  if (surface_) {
+    vkDestroySurfaceKHR(instance_, surface_, nullptr);
+    surface_ = VK_NULL_HANDLE;
   }
   if (messenger_) {
     auto destroy = (PFN_vkDestroyDebugUtilsMessengerEXT)vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT");

@@ -3,6 +3,11 @@
 // `deviceName` (a case-insensitive substring) forces one. Validation layers are enabled when
 // asked for or when PLUME_VALIDATION=1; every validation message is printed and counted, and
 // the tests fail on any.
+//
+// Presentation (the viewer) is opt-in through ContextOptions: extra instance extensions (those a
+// window system needs) and a callback that creates a VkSurfaceKHR once the instance exists. The
+// device is then one whose queue family supports compute, graphics and present to that surface,
+// with VK_KHR_swapchain enabled. The default stays headless and compute-only.
 #pragma once
 
 #include <vulkan/vulkan.h>
@@ -18,6 +23,10 @@ struct ContextOptions {
   std::string deviceName;  // empty: choose automatically
   bool validation = false;
   bool verbose = true;     // print the chosen device
+  // Presentation, all optional: instance extensions (e.g. glfwGetRequiredInstanceExtensions) and
+  // a surface factory called with the new instance. The Context owns and destroys the surface.
+  std::vector<std::string> instanceExtensions;
+  std::function<VkSurfaceKHR(VkInstance)> createSurface;
 };
 
 class Context {
@@ -27,6 +36,9 @@ class Context {
   Context(const Context&) = delete;
   Context& operator=(const Context&) = delete;
 
+  VkInstance instance() const { return instance_; }
+  VkSurfaceKHR surface() const { return surface_; }  // VK_NULL_HANDLE when headless
+  bool presents() const { return surface_ != VK_NULL_HANDLE; }
   VkDevice device() const { return device_; }
   VkPhysicalDevice physicalDevice() const { return physical_; }
   VkQueue queue() const { return queue_; }
@@ -57,6 +69,7 @@ class Context {
 
   VkInstance instance_ = VK_NULL_HANDLE;
   VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+  VkSurfaceKHR surface_ = VK_NULL_HANDLE;
   VkPhysicalDevice physical_ = VK_NULL_HANDLE;
   VkDevice device_ = VK_NULL_HANDLE;
   VkQueue queue_ = VK_NULL_HANDLE;

@@ -53,9 +53,11 @@ GpuVolumeResources::GpuVolumeResources(gpu::Context& ctx, const BakedVolume& bak
   indirection_.upload(packed.data(), packed.size() * 4);
   majorants_ = gpu::Buffer(ctx, majorants.size() * 4, storage, "majorant hierarchy");
   majorants_.upload(majorants.data(), majorants.size() * 4);
+  coarse_ = gpu::Buffer(ctx, bake.coarse1.size() * 4, storage, "coarse mip");
+  coarse_.upload(bake.coarse1.data(), bake.coarse1.size() * 4);
   counters_ = gpu::Buffer(ctx, 16, storage, "tracking counters");
   resetCounters();
-  bytes_ = sizeof(params_) + atlasBytes + bake.indirection.size() * 4 + majorants.size() * 4;
+  bytes_ = sizeof(params_) + atlasBytes + bake.indirection.size() * 4 + majorants.size() * 4 + bake.coarse1.size() * 4;
 }
 
 void GpuVolumeResources::bind(gpu::DescriptorSet& set) const {
@@ -64,6 +66,16 @@ void GpuVolumeResources::bind(gpu::DescriptorSet& set) const {
   set.bind(2, indirection_);
   set.bind(3, majorants_);
   set.bind(4, counters_);
+}
+
+void GpuVolumeResources::bindCoarse(gpu::DescriptorSet& set, uint32_t coarse) const { set.bind(coarse, coarse_); }
+
+void GpuVolumeResources::bindAsPrevious(gpu::DescriptorSet& set, uint32_t params, uint32_t atlas,
+                                        uint32_t indirection, uint32_t coarse) const {
+  set.bind(params, paramBuffer_);
+  set.bind(atlas, atlas_);
+  set.bind(indirection, indirection_);
+  set.bind(coarse, coarse_);
 }
 
 uint32_t GpuVolumeResources::truncatedCount() const {

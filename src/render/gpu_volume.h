@@ -17,6 +17,12 @@ class GpuVolumeResources {
 
   // Binds params (0), atlas (1), indirection (2), majorants (3), counters (4).
   void bind(gpu::DescriptorSet& set) const;
+  // Binds the coarse conservative mip (coarse1, 64 floats per atlas slot, slot index
+  // x + X * (y + Y * z) of the packed slot coordinates) at `coarse` (ReSTIR binding 8).
+  void bindCoarse(gpu::DescriptorSet& set, uint32_t coarse) const;
+  // Binds this volume as ReSTIR's previous-frame volume (bindings 9..12 of restir/bindings.glsl).
+  void bindAsPrevious(gpu::DescriptorSet& set, uint32_t params, uint32_t atlas, uint32_t indirection,
+                      uint32_t coarse) const;
   const shared::GpuVolume& params() const { return params_; }
   uint64_t deviceBytes() const { return bytes_; }
 
@@ -31,6 +37,7 @@ class GpuVolumeResources {
   gpu::Buffer indirection_;
   gpu::Buffer majorants_;
   gpu::Buffer counters_;
+  gpu::Buffer coarse_;
   uint64_t bytes_ = 0;
 };
 

@@ -83,7 +83,7 @@ std::vector<shared::GpuLight> gpuLights(const Scene& scene) {
 }  // namespace
 
 PathTracer::PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene)
-    : ctx_(ctx), scene_(scene), features_(featuresOf(scene)), timer_(ctx) {
+    : ctx_(ctx), scene_(scene), features_(featuresOf(scene)), compiler_(compiler), timer_(ctx) {
   if (!scene.surfaces.empty()) throw InputError(scene.path + ": surfaces: not supported by the GPU path tracer yet");
   for (size_t i = 0; i < scene.media.size(); ++i) {
     if (scene.media[i].emission) throw InputError(scene.path + strf(": media[%zu].emission: not supported yet", i));
@@ -91,14 +91,6 @@ PathTracer::PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const S
   for (size_t i = 0; i < scene.lights.size(); ++i) {
     if (!scene.lights[i].map.empty()) throw InputError(scene.path + strf(": lights[%zu].map: not supported yet", i));
   }
-  using gpu::BindingType;
-  std::vector<uint32_t> spirv = compiler.compile("passes/pt.comp", features_.defines());
-  pass_ = std::make_unique<gpu::ComputePass>(
-      ctx, spirv,
-      std::vector<BindingType>{BindingType::StorageBuffer, BindingType::SampledImage, BindingType::StorageBuffer,
-                               BindingType::StorageBuffer, BindingType::StorageBuffer, BindingType::StorageBuffer,
-                               BindingType::StorageBuffer, BindingType::StorageBuffer},
-      0, "path tracing [" + features_.name() + "]", glm::uvec3(8, 8, 1));
   const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   const size_t pixels = size_t(scene.camera.width) * scene.camera.height;
   frameBuffer_ = gpu::Buffer(ctx, sizeof(shared::GpuFrame), storage, "frame parameters");
@@ -106,12 +98,37 @@ PathTracer::PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const S
   lightBuffer_ = gpu::Buffer(ctx, lights.size() * sizeof(shared::GpuLight), storage, "lights");
   lightBuffer_.upload(lights.data(), lights.size() * sizeof(shared::GpuLight));
   accum_ = gpu::Buffer(ctx, pixels * 2 * sizeof(glm::vec4), storage, "accumulation");
-  pass_->set.bind(5, frameBuffer_);
-  pass_->set.bind(6, lightBuffer_);
-  pass_->set.bind(7, accum_);
+  pass_ = &makePass(false);
 }
 
-void PathTracer::setVolume(const GpuVolumeResources& volume) { volume.bind(pass_->set); }
+gpu::ComputePass& PathTracer::makePass(bool skipEmpty) {
+  std::unique_ptr<gpu::ComputePass>& pass = passes_[skipEmpty ? 1 : 0];
+  if (pass) return *pass;
+  using gpu::BindingType;
+  gpu::ShaderDefines defines = features_.defines();
+  if (skipEmpty) defines.emplace_back("PLUME_SKIP_EMPTY", "1");
+  pass = std::make_unique<gpu::ComputePass>(
+      ctx_, compiler_.compile("passes/pt.comp", defines),
+      std::vector<BindingType>{BindingType::StorageBuffer, BindingType::SampledImage, BindingType::StorageBuffer,
+                               BindingType::StorageBuffer, BindingType::StorageBuffer, BindingType::StorageBuffer,
+                               BindingType::StorageBuffer, BindingType::StorageBuffer},
+      0, "path tracing [" + features_.name() + (skipEmpty ? "+skip" : "") + "]", glm::uvec3(8, 8, 1));
+  pass->set.bind(5, frameBuffer_);
+  pass->set.bind(6, lightBuffer_);
+  pass->set.bind(7, accum_);
+  return *pass;
+}
+
+std::string PathTracer::variantName() const { return features_.name() + (skipEmpty_ ? "+skip" : ""); }
+
+void PathTracer::setVolume(const GpuVolumeResources& volume) {
+  // Skipping pays when rays cross many bricks: a brick grid wider than 16 on some axis.
+  const shared::GpuVolume& p = volume.params();
+  const int widest = std::max(p.brickDims.x, std::max(p.brickDims.y, p.brickDims.z));
+  skipEmpty_ = p.info.x >= 2u && widest > 16;
+  pass_ = &makePass(skipEmpty_);
+  volume.bind(pass_->set);
+}
 
 void PathTracer::beginFrame(int frame) {
   const Camera& cam = scene_.camera;

@@ -15,6 +15,7 @@
 namespace plume {
 
 // What a scene needs compiled in (DESIGN §5): light types present, multiple bounces.
+// (Whether tracking skips empty space is a property of the volume: see PathTracer::setVolume.)
 struct FeatureSet {
   bool sun = false, point = false, environment = false, multiBounce = false;
   gpu::ShaderDefines defines() const;
@@ -30,8 +31,11 @@ class PathTracer {
   PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene);
 
   const FeatureSet& features() const { return features_; }
-  // Binds a volume; call again when the volume changes (animation).
+  // Binds a volume; call again when the volume changes (animation). Large brick grids use the
+  // empty-space-skipping variant of the tracking code (compiled on first use).
   void setVolume(const GpuVolumeResources& volume);
+  // The shader variant in use, e.g. "sun+env+multi" or "sun+env+multi+skip".
+  std::string variantName() const;
   // Clears the accumulation and sets the camera and seeds for `frame`.
   void beginFrame(int frame);
   // Traces `spp` more samples per pixel (one dispatch, waits for it).
@@ -44,7 +48,12 @@ class PathTracer {
   gpu::Context& ctx_;
   const Scene& scene_;
   FeatureSet features_;
-  std::unique_ptr<gpu::ComputePass> pass_;
+  gpu::ComputePass& makePass(bool skipEmpty);
+
+  gpu::ShaderCompiler& compiler_;
+  std::unique_ptr<gpu::ComputePass> passes_[2];  // [skip empty space]
+  gpu::ComputePass* pass_ = nullptr;
+  bool skipEmpty_ = false;
   gpu::GpuTimer timer_;
   gpu::Buffer frameBuffer_, lightBuffer_, accum_;
   shared::GpuFrame frame_{};

@@ -21,6 +21,14 @@ const std::vector<SettingDesc>& renderSettingsTable() {
        &RenderSettings::seed, 0, 4294967295.0, {}},
       {"rr_start_bounce", "first bounce at which Russian roulette may end a path",
        &RenderSettings::rrStartBounce, 1, 100000, {}},
+      {"restir_candidates", "ReSTIR: candidate paths M per pixel and frame", &RenderSettings::restirCandidates, 1, 64, {}},
+      {"restir_neighbours", "ReSTIR: spatial neighbours k per round", &RenderSettings::restirNeighbours, 1, 8, {}},
+      {"restir_radius", "ReSTIR: spatial neighbour radius in pixels", &RenderSettings::restirRadius, 1, 256, {}},
+      {"restir_rounds", "ReSTIR: spatial reuse rounds R (0 = no spatial reuse)", &RenderSettings::restirRounds, 0, 8, {}},
+      {"restir_history_cap", "ReSTIR: temporal confidence cap c, M_hist <= c * M_cur (0 = no temporal reuse)",
+       &RenderSettings::restirHistoryCap, 0, 1000, {}},
+      {"restir_mis", "ReSTIR: MIS weights for reuse: pairwise (O(k)) or gbh (generalised balance heuristic, O(k^2))",
+       &RenderSettings::restirMis, 0, 0, {"pairwise", "gbh"}},
   };
   return table;
 }

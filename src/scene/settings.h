@@ -20,6 +20,13 @@ struct RenderSettings {
   int frameFirst = 1;        // render.frames = [first, last]
   int frameLast = 1;
   int rrStartBounce = 3;     // Russian roulette from this bounce on (unbiased)
+  // Volumetric ReSTIR (DESIGN §4.2; src/render/restir.h)
+  int restirCandidates = 4;          // M: candidate paths per pixel and frame
+  int restirNeighbours = 3;          // k: spatial neighbours per round
+  int restirRadius = 16;             // spatial neighbour radius, pixels
+  int restirRounds = 1;              // R: spatial rounds (0 = no spatial reuse)
+  int restirHistoryCap = 20;         // temporal confidence cap c: M_hist <= c * M_cur (0 = no temporal)
+  std::string restirMis = "pairwise";  // pairwise | gbh (generalised balance heuristic)
 };
 
 struct SettingDesc {

@@ -41,7 +41,7 @@ Image renderGpuPt(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene&
   tracer.beginFrame(frame);
   for (int done = 0; done < scene.render.spp; done += 16) tracer.addSamples(std::min(16, scene.render.spp - done));
   if (info) {
-    info->variant = tracer.features().name();
+    info->variant = tracer.variantName();
     info->truncated = volume.truncatedCount();
   }
   return tracer.readImage();

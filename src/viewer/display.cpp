@@ -1,0 +1,133 @@
+#include "viewer/display.h"
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/log.h"
+
+#include <glm/glm.hpp>
+#include <png.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace plume::viewer {
+namespace {
+
+struct DisplayPush {  // matches `Push` in shaders/viewer/display.comp
+  glm::uvec4 size;
+  glm::vec4 fit;
+  glm::uvec4 flags;
+};
+static_assert(sizeof(DisplayPush) == 48);
+
+void imageBarrier(VkCommandBuffer cmd, VkImage image, VkImageLayout from, VkImageLayout to, VkAccessFlags srcAccess,
+                  VkAccessFlags dstAccess, VkPipelineStageFlags srcStage, VkPipelineStageFlags dstStage) {
+  VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+  b.oldLayout = from;
+  b.newLayout = to;
+  b.srcAccessMask = srcAccess;
+  b.dstAccessMask = dstAccess;
+  b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  b.image = image;
+  b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+  vkCmdPipelineBarrier(cmd, srcStage, dstStage, 0, 0, nullptr, 0, nullptr, 1, &b);
+}
+
+}  // namespace
+
+DisplayPass::DisplayPass(gpu::Context& ctx, gpu::ShaderCompiler& compiler) : ctx_(ctx) {
+  using gpu::BindingType;
+  pass_ = std::make_unique<gpu::ComputePass>(ctx, compiler.compile("viewer/display.comp", {}),
+                                             std::vector<BindingType>{BindingType::StorageBuffer, BindingType::StorageBuffer},
+                                             uint32_t(sizeof(DisplayPush)), "display", glm::uvec3(16, 16, 1));
+}
+
+void DisplayPass::setSource(const Image& image) {
+  const VkDeviceSize bytes = image.rgb.size() * sizeof(float);
+  if (!src_.valid() || src_.size() != bytes) {
+    src_ = gpu::Buffer(ctx_, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "display source");
+    pass_->set.bind(0, src_);
+  }
+  src_.upload(image.rgb.data(), bytes);
+  srcWidth_ = image.width;
+  srcHeight_ = image.height;
+}
+
+void DisplayPass::record(VkCommandBuffer cmd, VkImage target, VkExtent2D extent, bool bgra, float exposureStops,
+                         gpu::GpuTimer* timer) {
+  PLUME_CHECK_MSG(src_.valid(), "DisplayPass::record before setSource");
+  const VkDeviceSize bytes = VkDeviceSize(extent.width) * extent.height * 4;
+  if (!dst_.valid() || dst_.size() != bytes) {
+    dst_ = gpu::Buffer(ctx_, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT, "display target");
+    pass_->set.bind(1, dst_);
+  }
+  // Fit the image into the window, aspect kept: `scale` source pixels per window pixel.
+  const float scale = std::max(float(srcWidth_) / float(extent.width), float(srcHeight_) / float(extent.height));
+  DisplayPush push{};
+  push.size = glm::uvec4(uint32_t(srcWidth_), uint32_t(srcHeight_), extent.width, extent.height);
+  push.fit = glm::vec4(0.5f * (float(extent.width) - float(srcWidth_) / scale),
+                       0.5f * (float(extent.height) - float(srcHeight_) / scale), scale, std::exp2(exposureStops));
+  push.flags = glm::uvec4(bgra ? 1u : 0u, 0u, 0u, 0u);
+  pass_->record(cmd, glm::uvec3(extent.width, extent.height, 1), &push, timer);
+  gpu::computeBarrier(cmd);
+  imageBarrier(cmd, target, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0,
+               VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
+  VkBufferImageCopy region{};
+  region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+  region.imageExtent = {extent.width, extent.height, 1};
+  vkCmdCopyBufferToImage(cmd, dst_.handle(), target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+}
+
+void ImageReadback::record(VkCommandBuffer cmd, VkImage image, VkExtent2D extent) {
+  const VkDeviceSize bytes = VkDeviceSize(extent.width) * extent.height * 4;
+  if (!buffer_.valid() || buffer_.size() != bytes) {
+    buffer_ = gpu::Buffer(ctx_, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, "window readback", gpu::MemoryUse::Staging);
+  }
+  extent_ = extent;
+  imageBarrier(cmd, image, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+               VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT, VK_ACCESS_TRANSFER_READ_BIT,
+               VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
+  VkBufferImageCopy region{};
+  region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+  region.imageExtent = {extent.width, extent.height, 1};
+  vkCmdCopyImageToBuffer(cmd, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buffer_.handle(), 1, &region);
+  imageBarrier(cmd, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
+               VK_ACCESS_TRANSFER_READ_BIT, 0, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT);
+}
+
+std::vector<unsigned char> ImageReadback::pixels(bool bgra) const {
+  const size_t n = size_t(extent_.width) * extent_.height;
+  std::vector<unsigned char> raw(4 * n), rgb(3 * n);
+  buffer_.download(raw.data(), raw.size());
+  for (size_t i = 0; i < n; ++i) {
+    rgb[3 * i + 0] = raw[4 * i + (bgra ? 2 : 0)];
+    rgb[3 * i + 1] = raw[4 * i + 1];
+    rgb[3 * i + 2] = raw[4 * i + (bgra ? 0 : 2)];
+  }
+  return rgb;
+}
+
+void writeRgb8Png(const std::string& path, int width, int height, const std::vector<unsigned char>& rgb) {
+  AtomicFile file(path);
+  FILE* fp = std::fopen(file.tempPath().c_str(), "wb");
+  if (!fp) throw InputError(strf("%s: cannot write PNG", path.c_str()));
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  png_infop info = png_create_info_struct(png);
+  if (setjmp(png_jmpbuf(png))) {
+    png_destroy_write_struct(&png, &info);
+    std::fclose(fp);
+    throw InputError(strf("%s: cannot write PNG", path.c_str()));
+  }
+  png_init_io(png, fp);
+  png_set_IHDR(png, info, width, height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
+               PNG_FILTER_TYPE_DEFAULT);
+  png_write_info(png, info);
+  for (int y = 0; y < height; ++y) png_write_row(png, const_cast<unsigned char*>(rgb.data() + 3 * size_t(y) * width));
+  png_write_end(png, nullptr);
+  png_destroy_write_struct(&png, &info);
+  if (std::fclose(fp) != 0) throw InputError(strf("%s: cannot write PNG", path.c_str()));
+  file.commit();
+}
+
+}  // namespace plume::viewer

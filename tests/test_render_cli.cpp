@@ -1,0 +1,147 @@
+// `plume render` as users and farms run it (issue 5, DESIGN §8): killed with SIGKILL mid-run and
+// rerun with --resume, no frame on disk is ever partial and the result equals an uninterrupted
+// run; same seed and device give the same pixels; a device that does not exist exits 3 naming
+// the devices there are; --preroll is accepted (a no-op for the path tracer).
+#include "core/log.h"
+#include "gpu/context.h"
+#include "io/image.h"
+#include "support/test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <csignal>
+#include <fcntl.h>
+#include <filesystem>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <thread>
+
+using namespace plume;
+namespace fs = std::filesystem;
+
+extern char** environ;
+
+namespace {
+
+const std::string kScene = test::sourcePath("volumes/smoke/smoke.json");
+
+std::string framePath(const std::string& dir, int frame) { return dir + "/f_" + strf("%04d", frame) + ".exr"; }
+
+// Small but not instant frames, so that a kill lands mid-sequence (~0.3 s each on lavapipe).
+std::vector<std::string> renderArgs(const std::string& dir, const std::string& frames) {
+  return {"render", kScene, "-o", dir + "/f_{frame:04}.exr", "--frames", frames, "--width", "80", "--height", "80",
+          "--spp", "48", "--batch", "4", "--seed", "11", "-q"};
+}
+
+}  // namespace
+
+TEST(RenderCli, KilledMidRunThenResumeCompletesAndMatchesAnUninterruptedRun) {
+  const std::string dir = test::outputDir("render_cli");
+  const std::string killedDir = dir + "/killed", refDir = dir + "/reference";
+  fs::create_directories(killedDir);
+  fs::create_directories(refDir);
+  const int first = 1, last = 6;
+
+  // Start the run as a child process and SIGKILL it once the first frame is on disk.
+  std::vector<std::string> args = renderArgs(killedDir, "1-6");
+  args.insert(args.begin(), PLUME_EXE);
+  std::vector<char*> argv;
+  for (auto& s : args) argv.push_back(s.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, 2, "/dev/null", O_WRONLY, 0);
+  pid_t pid = 0;
+  ASSERT_EQ(posix_spawn(&pid, PLUME_EXE, &actions, nullptr, argv.data(), environ), 0);
+  posix_spawn_file_actions_destroy(&actions);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (!fs::exists(framePath(killedDir, first)) && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  ::kill(pid, SIGKILL);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the render finished before it could be killed; make its frames slower";
+
+  // Every file with a frame's name is complete; the rest are hidden temporaries.
+  int complete = 0;
+  for (int f = first; f <= last; ++f) {
+    if (!fs::exists(framePath(killedDir, f))) continue;
+    Image img = readExr(framePath(killedDir, f));  // throws on a partial file
+    EXPECT_EQ(img.meta["frame"], std::to_string(f));
+    ++complete;
+  }
+  EXPECT_GE(complete, 1);
+  EXPECT_LT(complete, last - first + 1) << "killed mid-run, some frames must be missing";
+  for (const auto& e : fs::directory_iterator(killedDir)) {
+    const std::string name = e.path().filename().string();
+    const bool finalName = name.size() == 10 && name.rfind("f_", 0) == 0 && e.path().extension() == ".exr";
+    EXPECT_TRUE(finalName || (name[0] == '.' && name.find(".tmp") != std::string::npos)) << name;
+  }
+
+  test::RunResult resumed = test::runPlume([&] {
+    auto a = renderArgs(killedDir, "1-6");
+    a.back() = "--resume";  // not quiet: the skipped frames are logged
+    return a;
+  }());
+  ASSERT_EQ(resumed.exitCode, 0) << resumed.output;
+  EXPECT_NE(resumed.output.find("is complete, skipped"), std::string::npos) << resumed.output;
+
+  test::RunResult reference = test::runPlume(renderArgs(refDir, "1-6"));
+  ASSERT_EQ(reference.exitCode, 0) << reference.output;
+  for (int f = first; f <= last; ++f) {
+    Image a = readExr(framePath(killedDir, f)), b = readExr(framePath(refDir, f));
+    EXPECT_EQ(a.rgb, b.rgb) << "frame " << f << ": same seed and device must give the same pixels";
+  }
+}
+
+TEST(RenderCli, SameSeedSamePixelsAndMetadata) {
+  const std::string dir = test::outputDir("render_cli");
+  auto run = [&](const std::string& name, const std::string& seed) {
+    test::RunResult r = test::runPlume({"render", kScene, "-o", dir + "/" + name + ".exr", "--frames", "3", "--width",
+                                        "48", "--height", "40", "--spp", "8", "--seed", seed, "-q"});
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    return readExr(dir + "/" + name + ".exr");
+  };
+  Image a = run("a", "5"), b = run("b", "5"), c = run("c", "6");
+  EXPECT_EQ(a.rgb, b.rgb);
+  EXPECT_EQ(a.var, b.var);
+  EXPECT_NE(a.rgb, c.rgb) << "a different seed must change the noise";
+  for (const char* key : {"mode", "spp", "seed", "frame", "wall_time_s", "device", "version"}) {
+    EXPECT_FALSE(a.meta[key].empty()) << key;
+  }
+  EXPECT_EQ(a.meta["mode"], "pt");
+  EXPECT_EQ(a.meta["spp"], "8");
+  EXPECT_EQ(a.meta["seed"], "5");
+  EXPECT_EQ(a.meta["frame"], "3");
+}
+
+TEST(RenderCli, UnknownDeviceExitsThreeNamingTheDevices) {
+  const std::string dir = test::outputDir("render_cli");
+  test::RunResult r = test::runPlume({"render", kScene, "-o", dir + "/x.exr", "--frames", "1", "--device", "no-such-device"});
+  EXPECT_EQ(r.exitCode, 3) << r.output;
+  EXPECT_NE(r.output.find("no-such-device"), std::string::npos) << r.output;
+  for (const std::string& name : gpu::Context::listDevices()) {
+    EXPECT_NE(r.output.find(name), std::string::npos) << "the message should list " << name << ":\n" << r.output;
+  }
+  EXPECT_FALSE(fs::exists(dir + "/x.exr"));
+}
+
+TEST(RenderCli, PrerollIsAcceptedAndANoOpForThePathTracer) {
+  const std::string dir = test::outputDir("render_cli");
+  std::vector<std::string> base = {"render", kScene, "--frames", "4", "--width", "32", "--height", "24", "--spp", "4"};
+  auto with = [&](std::vector<std::string> extra, const std::string& out) {
+    std::vector<std::string> a = base;
+    a.insert(a.end(), {"-o", dir + "/" + out});
+    a.insert(a.end(), extra.begin(), extra.end());
+    return test::runPlume(a);
+  };
+  test::RunResult p = with({"--preroll", "3"}, "p.exr"), q = with({}, "q.exr");
+  ASSERT_EQ(p.exitCode, 0) << p.output;
+  ASSERT_EQ(q.exitCode, 0) << q.output;
+  EXPECT_NE(p.output.find("no effect with mode pt"), std::string::npos) << p.output;
+  EXPECT_EQ(readExr(dir + "/p.exr").rgb, readExr(dir + "/q.exr").rgb);
+  EXPECT_EQ(with({"--preroll", "-1"}, "r.exr").exitCode, 2);
+}
