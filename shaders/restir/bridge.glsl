@@ -1,0 +1,163 @@
+// The bridge between ReSTIR's algorithm (shared/reservoir.h, shared/restir_types.h) and our
+// resources: domains (a pixel's camera ray in a frame, with that frame's volume), the path
+// contribution f_D(y) — approximate (the target p̂) or unbiased (final shading) — candidate
+// generation, reservoir storage, and the one reuse step shared by the temporal and spatial passes.
+// Requires restir/bindings.glsl, volume/volume.glsl (unbiased tracking on the current volume)
+// and restir/coarse.glsl.
+#ifndef PLUME_RESTIR_BRIDGE_GLSL
+#define PLUME_RESTIR_BRIDGE_GLSL
+
+#include "../shared/phase.h"
+#include "../shared/rng.h"
+#include "../shared/sampling.h"
+
+// A domain of the integral: one pixel's camera ray in one frame and that frame's volume.
+struct RsDomain {
+  vec3 origin;
+  vec3 dir;
+  uint v;  // 0: current volume, 1: previous
+};
+
+// The pixel's camera ray of a frame: jittered inside the pixel (box filter) with a stream that
+// depends on (pixel, frame, seed) only, so every pass and the next frame rebuild the same ray.
+RsDomain rs_camera_domain(uvec2 pixel, uint frameNo, vec4 pos, vec4 fwd, vec4 right, vec4 up, uint v) {
+  RngState rng = rng_init(pixel, frameNo, RNG_STREAM_CAMERA, frame.seeds.x);
+  vec2 u = rng_float2(rng);
+  float sx = (2.0f * (float(pixel.x) + u.x) / float(frame.image.x) - 1.0f) * pos.w * fwd.w;
+  float sy = (1.0f - 2.0f * (float(pixel.y) + u.y) / float(frame.image.y)) * pos.w;
+  RsDomain D;
+  D.origin = pos.xyz;
+  D.dir = normalize(fwd.xyz + sx * right.xyz + sy * up.xyz);
+  D.v = v;
+  return D;
+}
+
+RsDomain rs_current_domain(uvec2 pixel) {
+  return rs_camera_domain(pixel, frame.seeds.y, frame.camPosition, frame.camForward, frame.camRight,
+                          frame.camUp, 0u);
+}
+
+RsDomain rs_previous_domain(uvec2 pixel) {
+  return rs_camera_domain(pixel, rsp.frames.x, rsp.prevCamPosition, rsp.prevCamForward,
+                          rsp.prevCamRight, rsp.prevCamUp, 1u);
+}
+
+float rs_luminance(vec3 c) { return (c.x + c.y + c.z) * (1.0f / 3.0f); }
+
+// --- Lights ----------------------------------------------------------------------------------
+// Direction (unit, towards the light), distance and emitted term of a light sample at x:
+// sun delta: irradiance; sun disk and environment: radiance (per unit solid angle of w);
+// point: intensity / r^2. The sample's two floats hold w for the disk and the environment.
+bool rs_light_geometry(GpuLight l, vec3 x, vec2 ls, out vec3 w, out float dist, out vec3 Le) {
+  uint type = uint(l.params.x);
+  dist = DDA_INF;
+  Le = l.emission.rgb;
+  if (type == LIGHT_SUN) {
+    w = l.params.y >= 1.0f ? l.dirOrPos.xyz : rs_decode_dir(ls);
+    return l.params.y >= 1.0f || dot(w, l.dirOrPos.xyz) >= l.params.y;
+  }
+  if (type == LIGHT_POINT) {
+    vec3 toL = l.dirOrPos.xyz - x;
+    dist = length(toL);
+    if (!(dist > 0.0f)) return false;
+    w = toL / dist;
+    Le = l.emission.rgb / (dist * dist);
+    return true;
+  }
+  w = rs_decode_dir(ls);  // environment
+  return true;
+}
+
+// Draws a light sample at x for a path arriving along wIn: light chosen uniformly; the disk
+// uniformly in its cone; the environment by phase sampling. Returns the sample's pdf (in the
+// light's measure, with the 1/nLights choice) or 0.
+float rs_sample_light(vec3 wIn, float g, vec3 u, out uint light, out vec2 ls) {
+  uint n = rsp.frames.w;
+  light = min(uint(u.x * float(n)), n - 1u);
+  GpuLight l = lights[light];
+  uint type = uint(l.params.x);
+  float pdf = 1.0f / float(n);
+  ls = vec2(0.0f);
+  if (type == LIGHT_SUN) {
+    if (l.params.y >= 1.0f) return pdf;
+    ls = rs_encode_dir(smp_uniform_cone(l.dirOrPos.xyz, l.params.y, u.yz));
+    vec3 w = rs_decode_dir(ls);
+    return dot(w, l.dirOrPos.xyz) >= l.params.y ? pdf * smp_uniform_cone_pdf(l.params.y) : 0.0f;
+  }
+  if (type == LIGHT_POINT) return pdf;
+  ls = rs_encode_dir(ph_hg_sample(wIn, g, u.yz));
+  return pdf * ph_hg(dot(rs_decode_dir(ls), wIn), g);
+}
+
+// Transmittance: the coarse deterministic one (target) or ratio tracking on the fine grid of the
+// current volume (unbiased; final shading only).
+float rs_transmittance(uint v, vec3 x, vec3 w, float dist, bool unbiased, inout RngState rng) {
+  return unbiased ? vol_ratio_tracking(x, w, dist, rng) : rs_coarse_tr(v, x, w, dist);
+}
+
+// The light term at the path's last vertex x (path arriving along wIn): Le * phase * T.
+vec3 rs_light_term(uint v, uint light, vec2 ls, vec3 x, vec3 wIn, bool unbiased, inout RngState rng) {
+  vec3 w;
+  float dist;
+  vec3 Le;
+  if (!rs_light_geometry(lights[light], x, ls, w, dist, Le)) return vec3(0.0f);
+  return Le * ph_hg(dot(w, wIn), frame.albedo.w) * rs_transmittance(v, x, w, dist, unbiased, rng);
+}
+
+// --- Path storage ----------------------------------------------------------------------------
+uint rs_slot(uint set, uint pixelIndex) { return set * rsp.frames.y + pixelIndex; }
+uint rs_bounce_base(uint set, uint pixelIndex) { return rs_slot(set, pixelIndex) * rsp.config.w; }
+
+RsReservoir rs_load(uint set, uint pixelIndex) {
+  bool dropped;
+  RsReservoir r = rs_unpack(rsReservoirs[rs_slot(set, pixelIndex)], dropped);
+  if (dropped) atomicAdd(rsCounters[0], 1u);
+  return r;
+}
+
+void rs_store(uint set, uint pixelIndex, RsReservoir r) { rsReservoirs[rs_slot(set, pixelIndex)] = rs_pack(r); }
+
+void rs_copy_path(uint srcSet, uint srcPixel, uint dstSet, uint dstPixel) {
+  RsPathHead h = rsPaths[rs_slot(srcSet, srcPixel)];
+  rsPaths[rs_slot(dstSet, dstPixel)] = h;
+  uint a = rs_bounce_base(srcSet, srcPixel);
+  uint b = rs_bounce_base(dstSet, dstPixel);
+  for (uint i = 1u; i < h.info.x; ++i) rsBounces[b + i - 1u] = rsBounces[a + i - 1u];
+}
+
+// --- The path contribution f_D(y) ------------------------------------------------------------
+// y is the path stored at (set, pixel); D any domain. Vertices x_1 = o + t1 d, x_i = x_{i-1} +
+// t_i w_i; f = prod_i [T(x_{i-1}, x_i) sigma_s(x_i)] * prod_{i>=2} phase(w_{i-1}, w_i) * light
+// term, RGB. A vertex with zero density (or outside the volume) makes f = 0: the shift fails.
+vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool unbiased, inout RngState rng) {
+  RsPathHead h = rsPaths[rs_slot(set, pixelIndex)];
+  uint n = h.info.x;
+  if (n == 0u) return vec3(0.0f);
+  uint base = rs_bounce_base(set, pixelIndex);
+  vec3 x = D.origin;
+  vec3 w = D.dir;
+  float t = h.geo.x;
+  vec3 f = vec3(1.0f);
+  for (uint i = 1u; i <= n; ++i) {
+    if (i >= 2u) {
+      vec4 b = rsBounces[base + i - 2u];
+      f *= ph_hg(dot(w, b.xyz), frame.albedo.w);
+      w = b.xyz;
+      t = b.w;
+    }
+    float tr = rs_transmittance(D.v, x, w, t, unbiased, rng);
+    x += t * w;
+    float sigma = rsv_sigma_t(D.v, x);
+    if (!(sigma > 0.0f)) return vec3(0.0f);
+    f *= tr * sigma * frame.albedo.rgb;
+  }
+  return f * rs_light_term(D.v, h.info.y, h.geo.yz, x, w, unbiased, rng);
+}
+
+// The target function p̂_D(y): deterministic (no random numbers are drawn on this path).
+float rs_target(RsDomain D, uint set, uint pixelIndex) {
+  RngState unused = rng_init(uvec2(0u), 0u, 0u, 0u);
+  return rs_luminance(rs_path_contribution(D, set, pixelIndex, false, unused));
+}
+
+#endif

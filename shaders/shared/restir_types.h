@@ -1,0 +1,109 @@
+// Volumetric ReSTIR (DESIGN §4.2): the path stored in a reservoir, the per-frame ReSTIR
+// parameters, the push constants of the passes, and the MIS weights of reuse. Shared by C++
+// and GLSL (common.h), so the tests check the weights on the CPU with the code the GPU runs.
+//
+// A path y, in the coordinates the shift copies (DESIGN §4.2 step 4):
+//   t1                      distance of the first vertex along the pixel's camera ray (world units)
+//   (w_i, t_i), i = 2..n    direction and distance of each further vertex (n <= RS_MAX_VERTICES)
+//   (light, u)              the light sample that ends the path: light index and two floats
+//                           (a direction for suns with a disk and the environment, unused for a
+//                           delta sun or a point light)
+// Its contribution f_D(y) in a domain D (camera ray, volume) is measured in dt1 dw2 dt2 ... dw_L,
+// so copying the coordinates into another domain has Jacobian 1 and the light reconnection to a
+// direction or a point has none either. A future surface vertex is one more kind of vertex in
+// the same list (a flag in RsPathHead.info.z), with its own measure and Jacobian.
+#ifndef PLUME_SHARED_RESTIR_TYPES_H
+#define PLUME_SHARED_RESTIR_TYPES_H
+
+#include "common.h"
+
+PLUME_NS_BEGIN
+
+const uint RS_MAX_VERTICES = 16u;  // longest path a reservoir stores (render.max_bounces <= this)
+const uint RS_MAX_NEIGHBOURS = 8u;
+
+const uint RS_MIS_PAIRWISE = 0u;  // pairwise MIS with confidence weights (default, O(k))
+const uint RS_MIS_GBH = 1u;       // generalised balance heuristic (O(k^2))
+const uint RS_MIS_BIASED = 2u;    // restir-biased: m_i = M_i / sum M, no MIS (biased)
+
+const uint RS_PASS_TEMPORAL = 0u;
+const uint RS_PASS_SPATIAL = 1u;
+
+// Stored path header (one per pixel and reservoir set); vertices 2..n live in a separate buffer
+// of vec4(direction, t), RestirParams.config.w (= max_bounces - 1) slots per pixel and set.
+struct RsPathHead {
+  vec4 geo;   // x: t1; y, z: light sample; w: unused
+  uvec4 info; // x: vertex count n (0: no path); y: light index; z: vertex kinds (0: all media)
+};
+
+// Per-frame parameters of the ReSTIR passes (beside GpuFrame, which holds the current camera).
+struct RestirParams {
+  vec4 prevCamPosition;  // previous frame's camera (same layout as GpuFrame's)
+  vec4 prevCamForward;
+  vec4 prevCamRight;
+  vec4 prevCamUp;
+  uvec4 config;   // x: M candidates; y: k neighbours; z: MIS kind (RS_MIS_*); w: bounce stride
+  vec4 configF;   // x: spatial radius (px); y: history cap c; z: reprojection depth (world); w: unused
+  uvec4 frames;   // x: previous frame number; y: pixel count; z: history valid (0/1); w: light count
+  uvec4 unused;
+};
+
+// Push constants: which reservoir sets a pass reads and writes.
+struct RsPush {
+  uvec4 sets;  // x: canonical input set; y: neighbour input set; z: output set; w: pass kind
+  uvec4 misc;  // x: spatial round; y..w unused
+};
+
+// --- Light sample encoding: a unit direction as (z, phi), exact enough for float storage ---
+PLUME_FN vec2 rs_encode_dir(vec3 w) { return vec2(w.z, atan(w.y, w.x)); }
+
+PLUME_FN vec3 rs_decode_dir(vec2 e) {
+  float z = clamp(e.x, -1.0f, 1.0f);
+  float r = sqrt(max(0.0f, 1.0f - z * z));
+  return vec3(r * cos(e.y), r * sin(e.y), z);
+}
+
+// --- MIS weights of reuse (GRIS, Lin et al. 2022; DESIGN §4.2 steps 5-6) -----------------------
+// Pairwise MIS with confidence weights (defensive form, Bitterli 2022 §9.1.3 extended to
+// confidences): with canonical confidence Mc, neighbour confidences M_i and Msum = Mc + Σ M_i,
+//   m_i(x) = (M_i / Msum) * b_i(x),   b_i(x) = M_i p̂_←i(x) / (M_i p̂_←i(x) + Mc p̂_c(x))
+//   m_c(x) = Mc / Msum + Σ_i (M_i / Msum) * (1 - b_i(x))
+// which sum to 1 for every x. p̂_←i(x) is the neighbour's target of x shifted into its domain
+// (0 when that shift fails): a failed shift gives b_i = 0 whichever way it is taken.
+
+// b_i: the neighbour's share of the pair (i, c) for a path with targets ph_i (neighbour domain)
+// and ph_c (canonical domain). 0 when both are 0 (no technique can produce it).
+PLUME_FN float rs_pair_share(float Mi, float ph_i, float Mc, float ph_c) {
+  float a = Mi * ph_i;
+  float d = a + Mc * ph_c;
+  return d > 0.0f ? a / d : 0.0f;
+}
+
+// m_i for a neighbour's own sample shifted into the canonical domain.
+PLUME_FN float rs_pairwise_neighbour(float Mi, float ph_i, float Mc, float ph_c, float Msum) {
+  return Msum > 0.0f ? (Mi / Msum) * rs_pair_share(Mi, ph_i, Mc, ph_c) : 0.0f;
+}
+
+// One pair's term of m_c for the canonical sample (accumulate over i, then add Mc / Msum).
+PLUME_FN float rs_pairwise_canonical_term(float Mi, float ph_i, float Mc, float ph_c, float Msum) {
+  return Msum > 0.0f ? (Mi / Msum) * (1.0f - rs_pair_share(Mi, ph_i, Mc, ph_c)) : 0.0f;
+}
+
+// Generalised balance heuristic: m_j(x) = M_j p̂_←j(x) / Σ_l M_l p̂_←l(x); the caller sums the
+// denominator over all domains (canonical included).
+PLUME_FN float rs_gbh(float Mj, float ph_j, float denominator) {
+  return denominator > 0.0f ? Mj * ph_j / denominator : 0.0f;
+}
+
+PLUME_NS_END
+
+#ifdef __cplusplus
+#include <cstddef>
+static_assert(sizeof(plume::shared::RsPathHead) == 32, "RsPathHead crosses the bus");
+static_assert(offsetof(plume::shared::RsPathHead, info) == 16, "RsPathHead layout");
+static_assert(sizeof(plume::shared::RestirParams) == 8 * 16, "RestirParams layout");
+static_assert(offsetof(plume::shared::RestirParams, config) == 64, "RestirParams layout");
+static_assert(sizeof(plume::shared::RsPush) == 32, "RsPush layout");
+#endif
+
+#endif

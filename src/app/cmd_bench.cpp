@@ -1,0 +1,55 @@
+// plume bench SCENE: error against run time (DESIGN §6): path tracer vs ReSTIR variants at equal
+// GPU time per frame, static and moving camera; markdown table, CSV and SVG plot.
+#include "app/commands.h"
+#include "app/settings_cli.h"
+#include "core/error.h"
+#include "core/log.h"
+#include "render/bench.h"
+
+#include <cstdio>
+#include <memory>
+
+namespace plume {
+namespace {
+
+struct BenchArgs {
+  std::string scene, device, out;
+  int width = 64, height = 64;
+  BenchOptions options;
+  SettingOverrides overrides;
+};
+
+int runBenchCommand(const BenchArgs& a) {
+  Scene scene = loadScene(a.scene);
+  applyOverrides(scene.render, a.overrides);
+  if (a.width > 0) scene.camera.width = a.width;
+  if (a.height > 0) scene.camera.height = a.height;
+  BenchOptions o = a.options;
+  o.outDir = a.out;
+  gpu::Context ctx({a.device, false, true});
+  gpu::ShaderCompiler compiler({}, gpu::ShaderCompiler::defaultCacheDir());
+  BenchResult r = runBench(ctx, compiler, scene, o);
+  std::printf("%s\nwrote %s, %s, %s\n", r.markdown.c_str(), r.mdPath.c_str(), r.csvPath.c_str(), r.svgPath.c_str());
+  return kExitOk;
+}
+
+}  // namespace
+
+void addBenchCommand(CLI::App& app, Action& action) {
+  auto args = std::make_shared<BenchArgs>();
+  CLI::App* cmd = app.add_subcommand("bench", "relMSE against GPU time per frame: path tracer vs ReSTIR variants");
+  cmd->add_option("scene", args->scene, "scene JSON file")->required();
+  cmd->add_option("-o,--output", args->out, "folder for the table, CSV and SVG (default: bench_out next to the scene)");
+  cmd->add_option("--width", args->width, "image width (default 64)")->check(CLI::Range(1, 16384));
+  cmd->add_option("--height", args->height, "image height (default 64)")->check(CLI::Range(1, 16384));
+  cmd->add_option("--warmup", args->options.warmup, "frames before measuring")->check(CLI::Range(0, 1000));
+  cmd->add_option("--measure", args->options.frames, "measured frames")->check(CLI::Range(1, 1000));
+  cmd->add_option("--ref-spp", args->options.refSpp, "samples per pixel of the cached reference")->check(CLI::Range(16, 1 << 24));
+  cmd->add_option("--pt-spp", args->options.ptSpp, "path tracer spp per frame (its curve)");
+  cmd->add_option("--orbit", args->options.orbitDegPerFrame, "moving camera: degrees of orbit per frame");
+  cmd->add_option("--device", args->device, "Vulkan device to use (substring of its name)");
+  addSettingOptions(*cmd, args->overrides);
+  cmd->callback([&action, args] { action = [args] { return runBenchCommand(*args); }; });
+}
+
+}  // namespace plume

@@ -1,0 +1,47 @@
+// Error against run time (DESIGN §6; `plume bench`): the path tracer and ReSTIR variants on one
+// device, in one process, alternating frame by frame, each frame's relMSE against a converged
+// reference of that frame's camera pose (cached EXR next to the scene), after a warm-up.
+// The path tracer runs at several spp, which gives its relMSE-against-time curve; each ReSTIR
+// variant's equal-time gain is the ratio of that curve (log-log interpolation) to its relMSE.
+#pragma once
+
+#include "gpu/context.h"
+#include "gpu/shader_compiler.h"
+#include "render/restir.h"
+#include "scene/scene.h"
+
+#include <string>
+#include <vector>
+
+namespace plume {
+
+struct BenchOptions {
+  int warmup = 4;          // frames before measuring (temporal reuse reaches steady state)
+  int frames = 6;          // measured frames
+  int refSpp = 2048;       // converged reference (GPU path tracer), >= 16x anything judged
+  std::vector<int> ptSpp{1, 2, 4, 8, 16};
+  std::vector<std::pair<std::string, RestirOptions>> variants;  // empty: a default list
+  float orbitDegPerFrame = 1.0f;  // the moving-camera run orbits the look-at point
+  std::string outDir;             // table, CSV, SVG
+};
+
+struct BenchRow {
+  std::string camera;  // "static" | "moving"
+  std::string method;
+  double frameMs = 0;  // median GPU time per frame (sum of pass timestamps)
+  double relMse = 0;   // median over measured frames
+  double ptRelMseAtEqualTime = 0;  // path tracer's curve at frameMs (ReSTIR rows)
+  double gain = 0;                 // ptRelMseAtEqualTime / relMse
+  std::string passTimes;           // median per-pass ms
+};
+
+struct BenchResult {
+  std::vector<BenchRow> rows;
+  double referenceRelMse = 0;  // estimated from the reference's own variance (worst frame)
+  std::string device;
+  std::string markdown, csvPath, svgPath, mdPath;
+};
+
+BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene, const BenchOptions& options);
+
+}  // namespace plume

@@ -1,0 +1,251 @@
+#include "render/restir.h"
+
+#include "core/error.h"
+#include "core/log.h"
+
+#include <glm/glm.hpp>
+
+#include <cmath>
+
+namespace plume {
+
+std::string RestirOptions::name() const {
+  const char* kind = mis == shared::RS_MIS_GBH ? "gbh" : mis == shared::RS_MIS_BIASED ? "biased" : "pairwise";
+  return strf("restir %s M%d k%d R%d c%d", kind, candidates, neighbours, rounds, historyCap);
+}
+
+RestirOptions restirOptionsOf(const RenderSettings& rs) {
+  RestirOptions o;
+  o.candidates = rs.restirCandidates;
+  o.neighbours = rs.restirNeighbours;
+  o.radius = rs.restirRadius;
+  o.rounds = rs.restirRounds;
+  o.historyCap = rs.restirHistoryCap;
+  o.mis = rs.restirMis == "gbh" ? shared::RS_MIS_GBH : shared::RS_MIS_PAIRWISE;
+  if (rs.mode == "restir-biased") o.mis = shared::RS_MIS_BIASED;
+  return o;
+}
+
+namespace {
+
+constexpr uint32_t kSets = 3;  // candidates / temporal / spatial rotate through three sets
+
+// The scene's lights for the shaders. (The same conversion as the path tracer's; it lives in
+// path_tracer.cpp's anonymous namespace, so it is repeated here until it moves to a shared place.)
+std::vector<shared::GpuLight> restirLights(const Scene& scene) {
+  std::vector<shared::GpuLight> out;
+  for (const Light& l : scene.lights) {
+    shared::GpuLight g{};
+    switch (l.type) {
+      case LightType::Sun: {
+        g.dirOrPos = glm::vec4(glm::normalize(l.toLight), 0.0f);
+        const double alpha = glm::radians(double(l.angularRadiusDeg));
+        const double s2 = std::sin(alpha) * std::sin(alpha);
+        g.emission = glm::vec4(alpha > 0 ? glm::vec3(glm::dvec3(l.irradiance) / (M_PI * s2)) : l.irradiance, 0.0f);
+        g.params = glm::vec4(float(shared::LIGHT_SUN), alpha > 0 ? float(std::cos(alpha)) : 1.0f, 0.0f, 0.0f);
+        break;
+      }
+      case LightType::Point:
+        g.dirOrPos = glm::vec4(l.position, 1.0f);
+        g.emission = glm::vec4(l.intensity, 0.0f);
+        g.params = glm::vec4(float(shared::LIGHT_POINT), 0.0f, 0.0f, 0.0f);
+        break;
+      case LightType::Environment:
+        g.emission = glm::vec4(l.radiance * l.scale, 0.0f);
+        g.params = glm::vec4(float(shared::LIGHT_ENVIRONMENT), 0.0f, 0.0f, 0.0f);
+        break;
+    }
+    out.push_back(g);
+  }
+  if (out.size() > size_t(shared::GPU_MAX_LIGHTS)) {
+    throw InputError(scene.path + strf(": lights: at most %d lights are supported", shared::GPU_MAX_LIGHTS));
+  }
+  if (out.empty()) out.push_back(shared::GpuLight{});
+  return out;
+}
+
+void cameraVectors(const Camera& cam, int frame, glm::vec4 out[4]) {
+  const CameraPose pose = cam.poseAt(frame);
+  const glm::vec3 forward = glm::normalize(pose.lookAt - pose.position);
+  const glm::vec3 right = glm::normalize(glm::cross(forward, pose.up));
+  const glm::vec3 up = glm::cross(right, forward);
+  out[0] = glm::vec4(pose.position, float(std::tan(glm::radians(double(pose.fovY)) * 0.5)));
+  out[1] = glm::vec4(forward, float(cam.width) / float(cam.height));
+  out[2] = glm::vec4(right, 0.0f);
+  out[3] = glm::vec4(up, 0.0f);
+}
+
+}  // namespace
+
+Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene, const RestirOptions& options)
+    : ctx_(ctx), scene_(scene), options_(options), features_(featuresOf(scene)), timer_(ctx, 32) {
+  if (!scene.surfaces.empty()) throw InputError(scene.path + ": surfaces: not supported by ReSTIR yet");
+  for (size_t i = 0; i < scene.media.size(); ++i) {
+    if (scene.media[i].emission) throw InputError(scene.path + strf(": media[%zu].emission: not supported yet", i));
+  }
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    if (!scene.lights[i].map.empty()) throw InputError(scene.path + strf(": lights[%zu].map: not supported yet", i));
+  }
+  if (scene.render.maxBounces > int(shared::RS_MAX_VERTICES)) {
+    throw InputError(scene.path + strf(": render.max_bounces: ReSTIR stores paths of at most %u vertices (got %d); "
+                                       "use mode pt for longer paths",
+                                       shared::RS_MAX_VERTICES, scene.render.maxBounces));
+  }
+  if (options_.neighbours > int(shared::RS_MAX_NEIGHBOURS)) {
+    throw InputError(scene.path + strf(": render.restir_neighbours: at most %u", shared::RS_MAX_NEIGHBOURS));
+  }
+  using gpu::BindingType;
+  const BindingType SB = BindingType::StorageBuffer, IMG = BindingType::SampledImage;
+  // restir/bindings.glsl: 0..4 volume, 5 frame, 6 lights, 7 params, 8 coarse, 9..12 previous
+  // volume, 13 reservoirs, 14 paths, 15 bounces, 16 output, 17 counters.
+  const std::vector<BindingType> bindings = {SB, IMG, SB, SB, SB, SB, SB, SB, SB, SB, IMG, SB, SB, SB, SB, SB, SB, SB};
+  const gpu::ShaderDefines defines = features_.defines();
+  const std::string variant = " [" + features_.name() + "]";
+  auto make = [&](const char* file, const char* name) {
+    return std::make_unique<gpu::ComputePass>(ctx, compiler.compile(file, defines), bindings,
+                                              uint32_t(sizeof(shared::RsPush)), name + variant, glm::uvec3(8, 8, 1));
+  };
+  candidates_ = make("passes/restir_candidates.comp", "restir candidates");
+  reuse_ = make("passes/restir_reuse.comp", "restir reuse");
+  shade_ = make("passes/restir_shade.comp", "restir shade");
+
+  const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+  const size_t pixels = size_t(scene.camera.width) * scene.camera.height;
+  const uint32_t stride = uint32_t(std::max(1, scene.render.maxBounces - 1));
+  frameBuffer_ = gpu::Buffer(ctx, sizeof(shared::GpuFrame), storage, "frame parameters");
+  std::vector<shared::GpuLight> lights = restirLights(scene);
+  lightBuffer_ = gpu::Buffer(ctx, lights.size() * sizeof(shared::GpuLight), storage, "lights");
+  lightBuffer_.upload(lights.data(), lights.size() * sizeof(shared::GpuLight));
+  paramBuffer_ = gpu::Buffer(ctx, sizeof(shared::RestirParams), storage, "restir parameters");
+  reservoirs_ = gpu::Buffer(ctx, kSets * pixels * sizeof(shared::RsPacked), storage, "reservoirs");
+  paths_ = gpu::Buffer(ctx, kSets * pixels * sizeof(shared::RsPathHead), storage, "reservoir paths");
+  bounces_ = gpu::Buffer(ctx, kSets * pixels * stride * sizeof(glm::vec4), storage, "reservoir path vertices");
+  output_ = gpu::Buffer(ctx, pixels * sizeof(glm::vec4), storage, "restir output");
+  counters_ = gpu::Buffer(ctx, 16, storage, "restir counters");
+  reservoirs_.fillZero();
+  paths_.fillZero();
+  for (gpu::ComputePass* p : {candidates_.get(), reuse_.get(), shade_.get()}) {
+    p->set.bind(5, frameBuffer_);
+    p->set.bind(6, lightBuffer_);
+    p->set.bind(7, paramBuffer_);
+    p->set.bind(13, reservoirs_);
+    p->set.bind(14, paths_);
+    p->set.bind(15, bounces_);
+    p->set.bind(16, output_);
+    p->set.bind(17, counters_);
+  }
+  params_.config = glm::uvec4(uint32_t(options_.candidates), uint32_t(options_.neighbours), options_.mis, stride);
+  params_.configF = glm::vec4(float(options_.radius), float(options_.historyCap), 1.0f, 0.0f);
+  params_.frames = glm::uvec4(0u, uint32_t(pixels), 0u, uint32_t(scene.lights.size()));
+}
+
+void Restir::setVolumes(const GpuVolumeResources& current, const GpuVolumeResources& previous) {
+  for (gpu::ComputePass* p : {candidates_.get(), reuse_.get(), shade_.get()}) {
+    current.bind(p->set);
+    current.bindCoarse(p->set, 8);
+    previous.bindAsPrevious(p->set, 9, 10, 11, 12);
+  }
+  // Reprojection depth: the distance from the camera to the volume's centre (a per-frame
+  // constant, so the history pixel never depends on a sample).
+  const shared::GpuVolume& v = current.params();
+  const glm::vec3 centre = glm::vec3(v.indexToWorld * glm::vec4(0.5f * (glm::vec3(v.boundsMin) + glm::vec3(v.boundsMax)), 1.0f));
+  centre_ = centre;
+}
+
+void Restir::resetHistory() { hasHistory_ = false; }
+
+void Restir::fillFrame(int frame, uint32_t sequence, uint32_t key) {
+  const Camera& cam = scene_.camera;
+  glm::vec4 c[4];
+  cameraVectors(cam, frame, c);
+  const Medium& m = scene_.media.at(0);
+  const RenderSettings& rs = scene_.render;
+  frame_.camPosition = c[0];
+  frame_.camForward = c[1];
+  frame_.camRight = c[2];
+  frame_.camUp = c[3];
+  frame_.albedo = glm::vec4(m.albedo, m.g);
+  frame_.image = glm::uvec4(uint32_t(cam.width), uint32_t(cam.height), 1u, uint32_t(rs.maxBounces));
+  frame_.seeds = glm::uvec4(uint32_t(rs.seed) + 0x9E3779B9u * sequence, key, 0u, uint32_t(rs.rrStartBounce));
+  frame_.lights = glm::uvec4(uint32_t(scene_.lights.size()), 0u, 0u, 0u);
+  const bool history = hasHistory_ && options_.historyCap > 0 && prevSequence_ == sequence;
+  if (history) {
+    params_.prevCamPosition = prevCam_[0];
+    params_.prevCamForward = prevCam_[1];
+    params_.prevCamRight = prevCam_[2];
+    params_.prevCamUp = prevCam_[3];
+  }
+  params_.frames.x = prevKey_;
+  params_.frames.z = history ? 1u : 0u;
+  params_.configF.z = glm::length(centre_ - glm::vec3(c[0]));
+  frameBuffer_.upload(&frame_, sizeof(frame_));
+  paramBuffer_.upload(&params_, sizeof(params_));
+  for (int i = 0; i < 4; ++i) prevCam_[i] = c[i];
+}
+
+Image Restir::renderFrame(int frame, uint32_t sequence, uint32_t iteration) {
+  const uint32_t key = uint32_t(frame) * 1024u + iteration;
+  fillFrame(frame, sequence, key);
+  const bool temporal = params_.frames.z != 0u;
+  const uint32_t zero[4] = {0, 0, 0, 0};
+  counters_.upload(zero, sizeof zero);
+  const glm::uvec3 items(uint32_t(scene_.camera.width), uint32_t(scene_.camera.height), 1u);
+  std::vector<std::string> labels;
+  uint32_t finalSet = 0;
+  ctx_.submitAndWait([&](VkCommandBuffer cmd) {
+    timer_.reset(cmd);
+    const uint32_t hist = history_;
+    uint32_t cur = (hist + 1) % kSets;
+    shared::RsPush push{};
+    push.sets = glm::uvec4(0u, 0u, cur, 0u);
+    candidates_->record(cmd, items, &push, &timer_);
+    labels.push_back("candidates");
+    gpu::computeBarrier(cmd);
+    if (temporal) {
+      const uint32_t out = (hist + 2) % kSets;
+      push.sets = glm::uvec4(cur, hist, out, shared::RS_PASS_TEMPORAL);
+      reuse_->record(cmd, items, &push, &timer_);
+      labels.push_back("temporal");
+      gpu::computeBarrier(cmd);
+      cur = out;
+    }
+    for (int r = 0; r < options_.rounds; ++r) {
+      const uint32_t out = (cur + 1) % kSets;
+      push.sets = glm::uvec4(cur, cur, out, shared::RS_PASS_SPATIAL);
+      push.misc = glm::uvec4(uint32_t(r), 0u, 0u, 0u);
+      reuse_->record(cmd, items, &push, &timer_);
+      labels.push_back(strf("spatial %d", r + 1));
+      gpu::computeBarrier(cmd);
+      cur = out;
+    }
+    push.sets = glm::uvec4(cur, cur, cur, 0u);
+    shade_->record(cmd, items, &push, &timer_);
+    labels.push_back("shade");
+    finalSet = cur;
+  });
+  passTimes_ = timer_.read();
+  for (size_t i = 0; i < passTimes_.size() && i < labels.size(); ++i) passTimes_[i].first = labels[i];
+  history_ = finalSet;
+  hasHistory_ = true;
+  prevKey_ = key;
+  prevSequence_ = sequence;
+  uint32_t counters[4];
+  counters_.download(counters, sizeof counters);
+  dropped_ = counters[0];
+
+  const Camera& cam = scene_.camera;
+  const size_t pixels = size_t(cam.width) * cam.height;
+  std::vector<glm::vec4> data(pixels);
+  output_.download(data.data(), data.size() * sizeof(glm::vec4));
+  Image image(cam.width, cam.height, false);
+  for (size_t i = 0; i < pixels; ++i) image.setPixel(int(i % size_t(cam.width)), int(i / size_t(cam.width)), glm::vec3(data[i]));
+  return image;
+}
+
+double Restir::lastFrameGpuMs() const {
+  double ms = 0;
+  for (const auto& [name, t] : passTimes_) ms += t;
+  return ms;
+}
+
+}  // namespace plume

@@ -1,0 +1,82 @@
+// Volumetric ReSTIR on the GPU (DESIGN §4.2): per frame, candidates -> temporal reuse ->
+// spatial reuse x R -> final shading, four compute passes (shaders/passes/restir_*.comp) over
+// three reservoir sets that rotate (the last frame's final set is the history). The host only
+// fills parameter blocks and picks sets; all reservoir arithmetic lives in the shaders
+// (shared/reservoir.h, shared/restir_types.h, restir/*.glsl).
+//
+// Modes: "restir" (unbiased: pairwise MIS by default, or the generalised balance heuristic) and
+// "restir-biased" (confidence-weighted 1/M resampling without MIS: biased where the neighbours'
+// supports differ, e.g. at the volume's silhouette; its bias is measured by the tests).
+#pragma once
+
+#include "gpu/pipeline.h"
+#include "gpu/shader_compiler.h"
+#include "io/image.h"
+#include "render/gpu_volume.h"
+#include "render/path_tracer.h"
+#include "scene/scene.h"
+#include "shaders/shared/reservoir.h"
+#include "shaders/shared/restir_types.h"
+
+#include <memory>
+#include <string>
+
+namespace plume {
+
+struct RestirOptions {
+  int candidates = 4;        // M
+  int neighbours = 3;        // k
+  int radius = 16;           // px
+  int rounds = 1;            // R (0: no spatial reuse)
+  int historyCap = 20;       // c (0: no temporal reuse)
+  uint32_t mis = shared::RS_MIS_PAIRWISE;
+  std::string name() const;  // e.g. "restir pairwise M4 k3 R1 c20"
+};
+// From the scene's render settings (mode restir-biased selects RS_MIS_BIASED).
+RestirOptions restirOptionsOf(const RenderSettings& rs);
+
+class Restir {
+ public:
+  Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene, const RestirOptions& options);
+
+  const RestirOptions& options() const { return options_; }
+  const FeatureSet& features() const { return features_; }
+  // The volume of the frame about to be rendered and the previous frame's (temporal reuse
+  // evaluates the history's target with it); pass the same volume twice for a still grid. Both
+  // must stay alive until the next setVolumes.
+  void setVolumes(const GpuVolumeResources& current, const GpuVolumeResources& previous);
+  // Forgets the history (the next frame has no temporal reuse), e.g. to start an independent run.
+  void resetHistory();
+  // Renders `frame` (camera pose of that frame) with seed render.seed + 0x9E3779B9 * sequence:
+  // independent sequences for the same frame are decorrelated. Returns the frame's image (one
+  // ReSTIR sample per pixel, no variance channel). `iteration` > 0 renders the same frame again
+  // with fresh random numbers (the random streams are keyed by frame * 1024 + iteration).
+  Image renderFrame(int frame, uint32_t sequence = 0, uint32_t iteration = 0);
+  const PassTimes& lastPassTimes() const { return passTimes_; }
+  double lastFrameGpuMs() const;
+  // Reservoir unpacks whose non-finite weights were dropped in the last frame (DESIGN §4.2.3).
+  uint32_t lastDroppedCount() const { return dropped_; }
+
+ private:
+  void fillFrame(int frame, uint32_t sequence, uint32_t key);
+
+  gpu::Context& ctx_;
+  const Scene& scene_;
+  RestirOptions options_;
+  FeatureSet features_;
+  std::unique_ptr<gpu::ComputePass> candidates_, reuse_, shade_;
+  gpu::GpuTimer timer_;
+  gpu::Buffer frameBuffer_, lightBuffer_, paramBuffer_, reservoirs_, paths_, bounces_, output_, counters_;
+  shared::GpuFrame frame_{};
+  shared::RestirParams params_{};
+  uint32_t history_ = 0;
+  bool hasHistory_ = false;
+  uint32_t prevKey_ = 0;  // random-stream key of the history's frame
+  uint32_t prevSequence_ = 0;
+  glm::vec4 prevCam_[4]{};
+  glm::vec3 centre_{0.0f};  // world centre of the volume's bounds (reprojection depth)
+  PassTimes passTimes_;
+  uint32_t dropped_ = 0;
+};
+
+}  // namespace plume
