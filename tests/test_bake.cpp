@@ -319,5 +319,36 @@ TEST(Bake, AtlasLayoutHoldsEverySlot) {
   EXPECT_TRUE(glm::all(glm::lessThanEqual(last + kBrickTexels, vol.atlasTexels)));
 }
 
+// coarse1Mean is the exact mean of the trilinear field over each 2³-voxel cell: the field is
+// multilinear on every unit voxel cell, so the midpoint rule on the 8 unit sub-cells is exact.
+TEST(Bake, CoarseMeanIsTheCellAverageOfTheTrilinearField) {
+  BakeOptions options;
+  options.format = TexelFormat::Float32;
+  const BakedVolume vol = bakeVolume(wrap(makeNoisyGrid()), options);
+  ASSERT_EQ(vol.coarse1Mean.size(), size_t(vol.slotCount) * 64);
+  int checked = 0, positive = 0;
+  double worst = 0;
+  for (int bz = 0; bz < vol.brickDims.z; ++bz)
+    for (int by = 0; by < vol.brickDims.y; ++by)
+      for (int bx = 0; bx < vol.brickDims.x; ++bx) {
+        const glm::ivec3 brick = vol.brickOrigin + glm::ivec3(bx, by, bz);
+        const uint32_t slot = brickSlot(vol, brick);
+        if (slot == 0) continue;
+        for (int c = 0; c < 64; ++c) {
+          const glm::ivec3 cell(c % 4, (c / 4) % 4, c / 16);
+          const glm::vec3 lo = glm::vec3(brick * kBrickVoxels + 2 * cell);
+          double sum = 0;
+          for (int k = 0; k < 8; ++k) sum += sampleDensity(vol, lo + glm::vec3(k & 1, (k >> 1) & 1, k >> 2) + 0.5f);
+          const double expected = sum / 8, got = vol.coarse1Mean[size_t(slot) * 64 + size_t(c)];
+          worst = std::max(worst, std::abs(got - expected));
+          EXPECT_NEAR(got, expected, 1e-5 * std::max(1.0, expected)) << "brick " << bx << "," << by << "," << bz << " cell " << c;
+          ++checked;
+          positive += expected > 0;
+        }
+      }
+  EXPECT_GT(checked, 1000);
+  EXPECT_GT(positive, 100);
+}
+
 }  // namespace
 }  // namespace plume

@@ -201,11 +201,9 @@ TEST_F(GpuRestir, CandidatesWithoutReuseMatchReference) {
 
 TEST_F(GpuRestir, MultipleScatteringWithoutReuseMatchesReference) {
   Scene s = baseScene(16);
-  // Two vertices with Russian roulette from the first: HG direction sampling, coarse tracking
+  // Four vertices with Russian roulette from the first: HG direction sampling, coarse tracking
   // from inside the medium and the roulette's probability all enter the candidates' pdf.
-  // (At 4 bounces and 4096 runs 2-4 pixels fail, moving with the reference's seed: heavy tails
-  // of the 512-spp reference or of ReSTIR; see the ReSTIR note.)
-  s.render.maxBounces = 2;
+  s.render.maxBounces = 4;
   s.render.rrStartBounce = 1;
   auto grid = test::makeNoiseGrid(40, 1.0 / 20, 3);
   RunSpec spec;
@@ -213,10 +211,7 @@ TEST_F(GpuRestir, MultipleScatteringWithoutReuseMatchesReference) {
   expectMatches(run, reference(s, grid, 512), "no_reuse_multi");
 }
 
-TEST_F(GpuRestir, DISABLED_SpatialReusePairwiseMatchesReference) {
-  // KNOWN FAILURE (see notes/restir.md): one pixel ~4.5-4.9 sigma low (threshold ~4.8), here and
-  // with max_bounces 2 and two rounds; GBH passes the same test. Suspected heavy tails of
-  // f / p̂ (ratio-tracked over coarse transmittance); a pairwise-weight error is not excluded.
+TEST_F(GpuRestir, SpatialReusePairwiseMatchesReference) {
   Scene s = baseScene(16);
   auto grid = test::makeNoiseGrid(40, 1.0 / 20, 2);
   RestirOptions o = noReuse();

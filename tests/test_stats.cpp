@@ -235,13 +235,16 @@ TEST(Stats, ZTestZeroVarianceAndNonFinite) {
   a.var.assign(6, 0.0f);
   Image b = a;
   EXPECT_TRUE(zTest(a, b).pass);  // exact matches where both variances are 0
-  b.rgb[2] = 2.0f * (1.0f + 1e-7f);
-  EXPECT_TRUE(zTest(a, b).pass);  // within the relative tolerance
-  b.rgb[2] = 2.001f;
+  b.rgb[2] = 2.0f * (1.0f + 1e-5f);
+  EXPECT_TRUE(zTest(a, b).pass);  // within the relative precision floor (kZTestRelativePrecision)
+  b.rgb[2] = 2.001f;              // 5 times the floor
   ZTestResult r = zTest(a, b);
   EXPECT_FALSE(r.pass);
   EXPECT_EQ(r.failingPixels, 1u);
-  EXPECT_TRUE(std::isinf(r.worstZ));
+  EXPECT_NEAR(r.worstZ, -5.0, 0.01);  // z = (a - b) / sigma, a = 2 < b
+  b.rgb[2] = 0.0f;
+  b.rgb[1] = 1e-30f;  // a non-zero value against an exact 0 with no variance: far outside
+  EXPECT_FALSE(zTest(a, b).pass);
   EXPECT_EQ(r.worstX, 0);
   EXPECT_EQ(r.worstChannel, 2);
   b = a;

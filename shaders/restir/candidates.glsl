@@ -1,5 +1,5 @@
 // Candidate paths (DESIGN §4.2 step 1). M random walks per pixel: each vertex's distance comes
-// from coarse tracking (pdf sigma_c exp(-tau_c), closed form), each further direction from HG
+// from coarse tracking in the conservative field (pdf sigma_c exp(-tau_c), closed form), each further direction from HG
 // sampling, and every vertex ends one candidate with a light sample. The candidate ending at
 // vertex j of walk m is the path (t1, w2, t2, ..., w_j, t_j, light) with source pdf
 //   p(y) = prod_i sigma_c(x_i) exp(-tau_i) * prod_{i>=2} phase_i * prod q (Russian roulette)
@@ -35,12 +35,12 @@ void rs_generate_candidates(uvec2 pixel, uint pixelIndex, uint outSet) {
       float sigmaC;
       float tau;
       if (!rs_coarse_sample(x, w, DDA_INF, rng_float(rng), t, sigmaC, tau)) break;
-      float trC = exp(-tau);
+      float trTarget = rs_coarse_tr(0u, x, w, t);  // the target's transmittance (mean field)
       x += t * w;
       float sigma = rsv_sigma_t(0u, x);
       if (!(sigma > 0.0f)) break;  // f = 0 for this path and every extension of it
-      pdf *= sigmaC * trC;
-      f *= trC * sigma * frame.albedo.rgb;
+      pdf *= sigmaC * exp(-tau);   // the sampling field's free-flight pdf
+      f *= trTarget * sigma * frame.albedo.rgb;
       if (j == 1u) {
         t1 = t;
       } else {

@@ -1,8 +1,11 @@
 // Volume lookups for ReSTIR's target function and candidates, for the current (v = 0) or the
 // previous frame's (v = 1) bake: fine trilinear density (the same arithmetic as
-// volume/volume.glsl's vol_density) and the coarse, conservative, piecewise-constant mip
-// (bake.coarse1 by default: one value per 2³ voxels, positive wherever the fine density is,
-// DESIGN §3).
+// volume/volume.glsl's vol_density) and two piecewise-constant coarse fields on 2³-voxel cells:
+// the conservative one (bake.coarse1, positive wherever the fine density is, DESIGN §3) that
+// candidate distances are drawn from, and the cell means of the trilinear field
+// (bake.coarse1Mean) that give the target's cheap deterministic transmittance. Keeping them apart
+// puts the dilation's extra optical depth into the candidates' resampling weights, which reuse
+// averages, instead of into f / p̂ at final shading, which no reuse can reduce.
 // Coarse tracking: in a piecewise-constant medium the majorant equals the density, so every
 // tentative collision is real and the free-flight pdf is sigma_c(t) exp(-tau_c(0, t)) in closed
 // form, with tau_c the exact optical depth of the coarse field, summed cell by cell with a DDA.
@@ -12,16 +15,13 @@
 
 #include "../shared/dda.h"
 
-// RS_COARSE_LEVEL 1: bake.coarse1 (2³ voxels per cell, 64 per brick); 2: bake.coarse2 (4³, 8).
-#ifndef RS_COARSE_LEVEL
-#define RS_COARSE_LEVEL 1
-#endif
-#if RS_COARSE_LEVEL == 1
+// Cells of bake.coarse1: 2³ voxels, 4³ per brick. The buffer holds, per atlas slot, the 64
+// conservative (dilated) cell values, for sampling distances, then the 64 trilinear means, for
+// the target's transmittance (render/gpu_volume.cpp).
 const int RS_COARSE_PER_BRICK = 4;   // cells per brick edge
-#else
-const int RS_COARSE_PER_BRICK = 2;
-#endif
-const float RS_COARSE_CELL = float(8 / RS_COARSE_PER_BRICK);  // voxels per cell edge
+const float RS_COARSE_CELL = 2.0f;   // voxels per cell edge
+const uint RS_COARSE_SAMPLING = 0u;  // which field: conservative, for sampling
+const uint RS_COARSE_MEAN = 1u;      // the trilinear mean, for approximate transmittance
 const float RS_MAX_TAU = 80.0f;      // exp(-80) > 0 in float: p̂ stays strictly positive
 
 float rsv_scale(uint v) { return v == 0u ? vol.boundsMin.w : prevVol.boundsMin.w; }
@@ -70,16 +70,16 @@ float rsv_sigma_t(uint v, vec3 xWorld) {
   return rsv_scale(v) * rsv_density(v, o);
 }
 
-// Coarse2 value of a cell of the coarse DDA grid (cell 0 = first voxel of brick brickOrigin).
-float rsv_coarse_cell(uint v, ivec3 cell) {
+// Value of a cell of the coarse DDA grid (cell 0 = first voxel of brick brickOrigin) in one of
+// the two fields (RS_COARSE_SAMPLING or RS_COARSE_MEAN).
+float rsv_coarse_cell(uint v, ivec3 cell, uint field) {
   ivec3 origin = v == 0u ? vol.brickOrigin.xyz : prevVol.brickOrigin.xyz;
   uint slot = rsv_packed_slot(v, origin + cell / RS_COARSE_PER_BRICK);
   if (slot == 0u) return 0.0f;
   ivec3 slots = v == 0u ? vol.atlasSlots.xyz : prevVol.atlasSlots.xyz;
   uint index = (slot & 1023u) + uint(slots.x) * (((slot >> 10u) & 1023u) + uint(slots.y) * (slot >> 20u));
   ivec3 c = cell % RS_COARSE_PER_BRICK;
-  uint i = index * uint(RS_COARSE_PER_BRICK * RS_COARSE_PER_BRICK * RS_COARSE_PER_BRICK) +
-           uint((c.z * RS_COARSE_PER_BRICK + c.y) * RS_COARSE_PER_BRICK + c.x);
+  uint i = index * 128u + field * 64u + uint((c.z * RS_COARSE_PER_BRICK + c.y) * RS_COARSE_PER_BRICK + c.x);
   return v == 0u ? volCoarse[i] : prevCoarse[i];
 }
 
@@ -90,7 +90,8 @@ bool rsv_coarse_start(uint v, vec3 o, vec3 d, float tMax, out DdaState s) {
   return dda_init(s, o, d, 0.0f, tMax, vec3(origin * 8), RS_COARSE_CELL, dims * RS_COARSE_PER_BRICK);
 }
 
-// Optical depth of the coarse field over (0, tMax) along a world ray (deterministic).
+// Optical depth of the coarse trilinear-mean field over (0, tMax) along a world ray
+// (deterministic; approximates the fine optical depth, not a bound).
 float rs_coarse_tau(uint v, vec3 xWorld, vec3 wWorld, float tMax) {
   vec3 o;
   vec3 d;
@@ -102,7 +103,7 @@ float rs_coarse_tau(uint v, vec3 xWorld, vec3 wWorld, float tMax) {
   float a;
   float b;
   ivec3 cell;
-  while (tau < RS_MAX_TAU && dda_next(s, a, b, cell)) tau += scale * rsv_coarse_cell(v, cell) * (b - a);
+  while (tau < RS_MAX_TAU && dda_next(s, a, b, cell)) tau += scale * rsv_coarse_cell(v, cell, RS_COARSE_MEAN) * (b - a);
   return tau;
 }
 
@@ -129,7 +130,7 @@ bool rs_coarse_sample(vec3 xWorld, vec3 wWorld, float tMax, float u, out float t
   float b;
   ivec3 cell;
   while (dda_next(s, a, b, cell)) {
-    float sigma = scale * rsv_coarse_cell(0u, cell);
+    float sigma = scale * rsv_coarse_cell(0u, cell, RS_COARSE_SAMPLING);
     float dtau = sigma * (b - a);
     if (sigma > 0.0f && dtau >= left) {
       t = a + left / sigma;

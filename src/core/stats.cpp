@@ -184,11 +184,10 @@ double channelZ(double a, double b, double variance) {
   if (!std::isfinite(a) || !std::isfinite(b) || !std::isfinite(variance) || variance < 0.0) {
     return std::numeric_limits<double>::infinity();
   }
-  if (variance == 0.0) {
-    const double tol = kZeroVarianceRelTolerance * std::max(std::abs(a), std::abs(b));
-    if (std::abs(a - b) <= tol) return 0.0;
-    return a > b ? std::numeric_limits<double>::infinity()
-                 : -std::numeric_limits<double>::infinity();
+  const double floor = kZTestRelativePrecision * std::max(std::abs(a), std::abs(b));
+  variance += floor * floor;
+  if (variance == 0.0) {  // both exactly 0
+    return a == b ? 0.0 : (a > b ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity());
   }
   return (a - b) / std::sqrt(variance);
 }

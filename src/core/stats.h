@@ -70,8 +70,12 @@ double meanRatio(std::span<const float> a, std::span<const float> b);
 
 // --- Per-pixel Z-tests -------------------------------------------------------------------
 constexpr double kZTestAlpha = 0.01;  // family-wise level over all pixels and channels
-// Where both variances are 0 the values must match exactly, up to this relative tolerance.
-constexpr double kZeroVarianceRelTolerance = 1e-6;
+// Relative precision floor of every channel test: (kZTestRelativePrecision * max(|a|, |b|))^2 is
+// added to the variance. Two correct renderers differ by float and half-texel rounding (the
+// bake's storage error is up to 2.4e-4 of the density), and a Monte Carlo variance estimate of
+// 0 only means no rare event was sampled (a pixel whose reference rays all missed a faint wisp
+// that the other renderer grazed): neither may turn the test into an exact-equality check.
+constexpr double kZTestRelativePrecision = 1e-4;
 
 struct ZTestResult {
   bool pass = true;

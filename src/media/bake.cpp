@@ -223,6 +223,19 @@ void writeCoarse(BakedVolume& vol, uint32_t slot, const Window& w, float fractio
   for (int z = 0; z < 4; ++z)
     for (int y = 0; y < 4; ++y)
       for (int x = 0; x < 4; ++x) c1[(z * 4 + y) * 4 + x] = mean(2, 2 * x, 2 * y, 2 * z);
+  // The trilinear field's mean over cell c (2 voxels per axis) is sum over voxels 2c + {0,1,2}
+  // of the separable weights (1/4, 1/2, 1/4) (integrate the hat functions over the cell).
+  const float hat[3] = {0.25f, 0.5f, 0.25f};
+  float* m1 = &vol.coarse1Mean[size_t(slot) * 64];
+  for (int z = 0; z < 4; ++z)
+    for (int y = 0; y < 4; ++y)
+      for (int x = 0; x < 4; ++x) {
+        double sum = 0.0;
+        for (int k = 0; k < 3; ++k)
+          for (int j = 0; j < 3; ++j)
+            for (int i = 0; i < 3; ++i) sum += hat[k] * hat[j] * hat[i] * w[windowIndex(2 * x + i + 1, 2 * y + j + 1, 2 * z + k + 1)];
+        m1[(z * 4 + y) * 4 + x] = float(sum);
+      }
   float* c2 = &vol.coarse2[size_t(slot) * 8];
   for (int z = 0; z < 2; ++z)
     for (int y = 0; y < 2; ++y)
@@ -315,6 +328,7 @@ void fillBricks(BakedVolume& vol, const openvdb::FloatGrid& grid, const BrickBox
   else vol.atlasF16.assign(texels, 0);
   vol.coarse1.assign(size_t(vol.slotCount) * 64, 0.0f);
   vol.coarse2.assign(size_t(vol.slotCount) * 8, 0.0f);
+  vol.coarse1Mean.assign(size_t(vol.slotCount) * 64, 0.0f);
   std::vector<float> brickMajorant(box.count(), 0.0f);
   for (const auto& [b, s] : slots) vol.indirection[b] = s;
 

@@ -85,6 +85,10 @@ struct BakedVolume {
   // coarse2[slot*8 + (z*2+y)*2+x]  = mean over voxels 8b + 4(x,y,z) + {0..3}³.
   std::vector<float> coarse1;
   std::vector<float> coarse2;
+  // Not conservative, for approximate transmittance (ReSTIR's target function): the exact mean
+  // of the trilinear field over each coarse1 cell, i.e. weights (1/4, 1/2, 1/4) per axis over
+  // voxels 2c + {0, 1, 2}. coarse1Mean[slot*64 + (z*4+y)*4+x], like coarse1.
+  std::vector<float> coarse1Mean;
 
   // Index -> world affine map of the grid (column vectors: world = indexToWorld * (i,j,k,1)).
   glm::mat4 indexToWorld{1.0f};

@@ -53,11 +53,17 @@ GpuVolumeResources::GpuVolumeResources(gpu::Context& ctx, const BakedVolume& bak
   indirection_.upload(packed.data(), packed.size() * 4);
   majorants_ = gpu::Buffer(ctx, majorants.size() * 4, storage, "majorant hierarchy");
   majorants_.upload(majorants.data(), majorants.size() * 4);
-  coarse_ = gpu::Buffer(ctx, bake.coarse1.size() * 4, storage, "coarse mip");
-  coarse_.upload(bake.coarse1.data(), bake.coarse1.size() * 4);
+  // Per atlas slot 128 floats: the conservative coarse1 cells (64), then their trilinear means (64).
+  std::vector<float> coarse(bake.coarse1.size() * 2);
+  for (size_t slot = 0; slot < bake.coarse1.size() / 64; ++slot) {
+    std::copy_n(&bake.coarse1[slot * 64], 64, &coarse[slot * 128]);
+    std::copy_n(&bake.coarse1Mean[slot * 64], 64, &coarse[slot * 128 + 64]);
+  }
+  coarse_ = gpu::Buffer(ctx, coarse.size() * 4, storage, "coarse mip");
+  coarse_.upload(coarse.data(), coarse.size() * 4);
   counters_ = gpu::Buffer(ctx, 16, storage, "tracking counters");
   resetCounters();
-  bytes_ = sizeof(params_) + atlasBytes + bake.indirection.size() * 4 + majorants.size() * 4 + bake.coarse1.size() * 4;
+  bytes_ = sizeof(params_) + atlasBytes + bake.indirection.size() * 4 + majorants.size() * 4 + bake.coarse1.size() * 8;
 }
 
 void GpuVolumeResources::bind(gpu::DescriptorSet& set) const {
