@@ -14,20 +14,10 @@
 namespace plume {
 namespace {
 
-struct ReferenceArgs {
-  std::string scene;
-  FrameOutputs outputs;
-  bool quiet = false;
-  int width = 0, height = 0;
-  SettingOverrides overrides;
-};
+using ReferenceArgs = FrameJobArgs;
 
 int runReference(const ReferenceArgs& a) {
-  setQuiet(a.quiet);
-  Scene scene = loadScene(a.scene);
-  applyOverrides(scene.render, a.overrides);
-  if (a.width > 0) scene.camera.width = a.width;
-  if (a.height > 0) scene.camera.height = a.height;
+  Scene scene = loadJobScene(a);
   ref::checkReferenceSupports(scene);
   const RenderSettings& rs = scene.render;
   a.outputs.check(rs);
@@ -58,14 +48,7 @@ int runReference(const ReferenceArgs& a) {
 void addReferenceCommand(CLI::App& app, Action& action) {
   auto args = std::make_shared<ReferenceArgs>();
   CLI::App* cmd = app.add_subcommand("reference", "CPU delta-tracking reference render (mean + variance EXR)");
-  cmd->add_option("scene", args->scene, "scene JSON file")->required();
-  cmd->add_option("-o,--output", args->outputs.pattern, "output EXR; {frame:04} is replaced by the frame")->required();
-  cmd->add_flag("--png", args->outputs.png, "also write a tone-mapped PNG preview beside each EXR");
-  cmd->add_flag("--resume", args->outputs.resume, "skip frames whose EXR is already complete");
-  cmd->add_flag("-q,--quiet", args->quiet, "no progress bar or log lines");
-  cmd->add_option("--width", args->width, "override camera.width")->check(CLI::Range(1, 16384));
-  cmd->add_option("--height", args->height, "override camera.height")->check(CLI::Range(1, 16384));
-  addSettingOptions(*cmd, args->overrides);
+  addFrameJobOptions(*cmd, *args);
   cmd->callback([&action, args] { action = [args] { return runReference(*args); }; });
 }
 

@@ -21,16 +21,11 @@
 namespace plume {
 namespace {
 
-struct RenderArgs {
-  std::string scene;
-  FrameOutputs outputs;
-  bool quiet = false;
-  int width = 0, height = 0;
+struct RenderArgs : FrameJobArgs {
   int batch = 4;
   int preroll = 0;
   std::string device;
   std::string texels = "float16";
-  SettingOverrides overrides;
 };
 
 std::string passTimesText(const PassTimes& times) {
@@ -105,11 +100,7 @@ int runRestirRender(const RenderArgs& a, const Scene& scene) {
 }
 
 int runRender(const RenderArgs& a) {
-  setQuiet(a.quiet);
-  Scene scene = loadScene(a.scene);
-  applyOverrides(scene.render, a.overrides);
-  if (a.width > 0) scene.camera.width = a.width;
-  if (a.height > 0) scene.camera.height = a.height;
+  Scene scene = loadJobScene(a);
   const RenderSettings& rs = scene.render;
   if (a.preroll > 0 && !carriesHistory(rs.mode)) {
     logInfo(strf("--preroll %d: no effect with mode %s (its frames are independent)", a.preroll, rs.mode.c_str()));
@@ -178,13 +169,7 @@ int runRender(const RenderArgs& a) {
 void addRenderCommand(CLI::App& app, Action& action) {
   auto args = std::make_shared<RenderArgs>();
   CLI::App* cmd = app.add_subcommand("render", "render frames with the Vulkan renderer (mean + variance EXR)");
-  cmd->add_option("scene", args->scene, "scene JSON file")->required();
-  cmd->add_option("-o,--output", args->outputs.pattern, "output EXR; {frame:04} is replaced by the frame")->required();
-  cmd->add_flag("--png", args->outputs.png, "also write a tone-mapped PNG preview beside each EXR");
-  cmd->add_flag("--resume", args->outputs.resume, "skip frames whose EXR is already complete");
-  cmd->add_flag("-q,--quiet", args->quiet, "no progress bar or log lines");
-  cmd->add_option("--width", args->width, "override camera.width")->check(CLI::Range(1, 16384));
-  cmd->add_option("--height", args->height, "override camera.height")->check(CLI::Range(1, 16384));
+  addFrameJobOptions(*cmd, *args);
   cmd->add_option("--batch", args->batch, "samples per pixel per dispatch")->check(CLI::Range(1, 4096));
   cmd->add_option("--preroll", args->preroll,
                   "warm temporal reuse on up to K frames before the first one (not written; for chunks that start "
@@ -193,7 +178,6 @@ void addRenderCommand(CLI::App& app, Action& action) {
   cmd->add_option("--device", args->device, "Vulkan device to use (substring of its name)");
   cmd->add_option("--texels", args->texels, "brick atlas storage: float16 (default) or float32")
       ->check(CLI::IsMember({"float16", "float32"}));
-  addSettingOptions(*cmd, args->overrides);
   cmd->callback([&action, args] { action = [args] { return runRender(*args); }; });
 }
 

@@ -141,4 +141,24 @@ void FrameProgress::finish() {
                done_ > 0 ? strf(" (%.2fs/frame)", sumSeconds_ / done_).c_str() : ""));
 }
 
+void addFrameJobOptions(CLI::App& cmd, FrameJobArgs& a) {
+  cmd.add_option("scene", a.scene, "scene JSON file")->required();
+  cmd.add_option("-o,--output", a.outputs.pattern, "output EXR; {frame:04} is replaced by the frame")->required();
+  cmd.add_flag("--png", a.outputs.png, "also write a tone-mapped PNG preview beside each EXR");
+  cmd.add_flag("--resume", a.outputs.resume, "skip frames whose EXR is already complete");
+  cmd.add_flag("-q,--quiet", a.quiet, "no progress bar or log lines");
+  cmd.add_option("--width", a.width, "override camera.width")->check(CLI::Range(1, 16384));
+  cmd.add_option("--height", a.height, "override camera.height")->check(CLI::Range(1, 16384));
+  addSettingOptions(cmd, a.overrides);
+}
+
+Scene loadJobScene(const FrameJobArgs& a) {
+  setQuiet(a.quiet);
+  Scene scene = loadScene(a.scene);
+  applyOverrides(scene.render, a.overrides);
+  if (a.width > 0) scene.camera.width = a.width;
+  if (a.height > 0) scene.camera.height = a.height;
+  return scene;
+}
+
 }  // namespace plume

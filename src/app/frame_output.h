@@ -4,7 +4,9 @@
 // frame sequence (bar with per-frame time and ETA on a terminal, one log line per frame otherwise).
 #pragma once
 
+#include "app/settings_cli.h"
 #include "io/image.h"
+#include "scene/scene.h"
 #include "scene/settings.h"
 
 #include <chrono>
@@ -50,5 +52,19 @@ class FrameProgress {
   double sumSeconds_ = 0, lastSeconds_ = 0;
   std::chrono::steady_clock::time_point start_, frameStart_, lastDraw_;
 };
+
+// What every frame-producing command takes: the scene, -o/--png/--resume, -q, --width/--height
+// and every render.* setting as a flag.
+struct FrameJobArgs {
+  std::string scene;
+  FrameOutputs outputs;
+  bool quiet = false;
+  int width = 0, height = 0;
+  SettingOverrides overrides;
+};
+
+void addFrameJobOptions(CLI::App& cmd, FrameJobArgs& args);
+// Loads the scene with the command line's overrides applied; sets the log's quietness.
+Scene loadJobScene(const FrameJobArgs& args);
 
 }  // namespace plume

@@ -128,12 +128,16 @@ float toneMap(float x) {
 }  // namespace
 
 void writePng(const std::string& path, const Image& image, float exposureStops) {
-  AtomicFile file(path);
   const float scale = std::exp2(exposureStops);
   std::vector<unsigned char> pixels(3 * image.pixelCount());
   for (size_t i = 0; i < pixels.size(); ++i) {
     pixels[i] = (unsigned char)std::lround(255.0f * toneMap(scale * image.rgb[i]));
   }
+  writeRgb8Png(path, image.width, image.height, pixels);
+}
+
+void writeRgb8Png(const std::string& path, int width, int height, const std::vector<unsigned char>& rgb) {
+  AtomicFile file(path);
   FILE* fp = std::fopen(file.tempPath().c_str(), "wb");
   if (!fp) throw InputError(strf("%s: cannot write PNG", path.c_str()));
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
@@ -144,12 +148,10 @@ void writePng(const std::string& path, const Image& image, float exposureStops) 
     throw InputError(strf("%s: cannot write PNG", path.c_str()));
   }
   png_init_io(png, fp);
-  png_set_IHDR(png, info, image.width, image.height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
-               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  png_set_IHDR(png, info, width, height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
+               PNG_FILTER_TYPE_DEFAULT);
   png_write_info(png, info);
-  for (int y = 0; y < image.height; ++y) {
-    png_write_row(png, pixels.data() + 3 * size_t(y) * image.width);
-  }
+  for (int y = 0; y < height; ++y) png_write_row(png, const_cast<unsigned char*>(rgb.data() + 3 * size_t(y) * width));
   png_write_end(png, nullptr);
   png_destroy_write_struct(&png, &info);
   if (std::fclose(fp) != 0) throw InputError(strf("%s: cannot write PNG", path.c_str()));

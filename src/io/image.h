@@ -35,5 +35,7 @@ Image readExr(const std::string& path);
 
 // Tone-mapped sRGB preview (exposure in stops, then a simple filmic curve). Never measured.
 void writePng(const std::string& path, const Image& image, float exposureStops = 0.0f);
+// 8-bit RGB rows, top row first (a captured window, an already tone-mapped buffer).
+void writeRgb8Png(const std::string& path, int width, int height, const std::vector<unsigned char>& rgb);
 
 }  // namespace plume

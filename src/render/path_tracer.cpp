@@ -2,6 +2,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "render/gpu_scene.h"
 
 #include <glm/glm.hpp>
 
@@ -41,56 +42,10 @@ FeatureSet featuresOf(const Scene& scene) {
   return f;
 }
 
-namespace {
-
-std::vector<shared::GpuLight> gpuLights(const Scene& scene) {
-  std::vector<shared::GpuLight> out;
-  for (const Light& l : scene.lights) {
-    shared::GpuLight g{};
-    switch (l.type) {
-      case LightType::Sun: {
-        g.dirOrPos = glm::vec4(glm::normalize(l.toLight), 0.0f);
-        const double alpha = glm::radians(double(l.angularRadiusDeg));
-        if (alpha > 0) {
-          // A disk of uniform radiance L with irradiance E: E = L * pi * sin^2(alpha).
-          g.emission = glm::vec4(glm::dvec3(l.irradiance) / (M_PI * std::sin(alpha) * std::sin(alpha)), 0.0f);
-          g.params = glm::vec4(float(shared::LIGHT_SUN), float(std::cos(alpha)), 0.0f, 0.0f);
-        } else {
-          g.emission = glm::vec4(l.irradiance, 0.0f);
-          g.params = glm::vec4(float(shared::LIGHT_SUN), 1.0f, 0.0f, 0.0f);
-        }
-        break;
-      }
-      case LightType::Point:
-        g.dirOrPos = glm::vec4(l.position, 1.0f);
-        g.emission = glm::vec4(l.intensity, 0.0f);
-        g.params = glm::vec4(float(shared::LIGHT_POINT), 0.0f, 0.0f, 0.0f);
-        break;
-      case LightType::Environment:
-        g.emission = glm::vec4(l.radiance * l.scale, 0.0f);
-        g.params = glm::vec4(float(shared::LIGHT_ENVIRONMENT), 0.0f, 0.0f, 0.0f);
-        break;
-    }
-    out.push_back(g);
-  }
-  if (out.size() > size_t(shared::GPU_MAX_LIGHTS)) {
-    throw InputError(scene.path + strf(": lights: at most %d lights are supported", shared::GPU_MAX_LIGHTS));
-  }
-  if (out.empty()) out.push_back(shared::GpuLight{});  // keep the buffer non-empty
-  return out;
-}
-
-}  // namespace
 
 PathTracer::PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene)
     : ctx_(ctx), scene_(scene), features_(featuresOf(scene)), compiler_(compiler), timer_(ctx) {
-  if (!scene.surfaces.empty()) throw InputError(scene.path + ": surfaces: not supported by the GPU path tracer yet");
-  for (size_t i = 0; i < scene.media.size(); ++i) {
-    if (scene.media[i].emission) throw InputError(scene.path + strf(": media[%zu].emission: not supported yet", i));
-  }
-  for (size_t i = 0; i < scene.lights.size(); ++i) {
-    if (!scene.lights[i].map.empty()) throw InputError(scene.path + strf(": lights[%zu].map: not supported yet", i));
-  }
+  checkGpuSupports(scene, "the GPU path tracer");
   const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   const size_t pixels = size_t(scene.camera.width) * scene.camera.height;
   frameBuffer_ = gpu::Buffer(ctx, sizeof(shared::GpuFrame), storage, "frame parameters");
@@ -132,16 +87,14 @@ void PathTracer::setVolume(const GpuVolumeResources& volume) {
 
 void PathTracer::beginFrame(int frame) {
   const Camera& cam = scene_.camera;
-  const CameraPose pose = cam.poseAt(frame);
-  const glm::vec3 forward = glm::normalize(pose.lookAt - pose.position);
-  const glm::vec3 right = glm::normalize(glm::cross(forward, pose.up));
-  const glm::vec3 up = glm::cross(right, forward);
   const Medium& m = scene_.media.at(0);
   const RenderSettings& rs = scene_.render;
-  frame_.camPosition = glm::vec4(pose.position, float(std::tan(glm::radians(double(pose.fovY)) * 0.5)));
-  frame_.camForward = glm::vec4(forward, float(cam.width) / float(cam.height));
-  frame_.camRight = glm::vec4(right, 0.0f);
-  frame_.camUp = glm::vec4(up, 0.0f);
+  glm::vec4 c[4];
+  gpuCameraVectors(cam, frame, c);
+  frame_.camPosition = c[0];
+  frame_.camForward = c[1];
+  frame_.camRight = c[2];
+  frame_.camUp = c[3];
   frame_.albedo = glm::vec4(m.albedo, m.g);
   frame_.image = glm::uvec4(uint32_t(cam.width), uint32_t(cam.height), 0u, uint32_t(rs.maxBounces));
   frame_.seeds = glm::uvec4(uint32_t(rs.seed), uint32_t(frame), 0u, uint32_t(rs.rrStartBounce));

@@ -2,6 +2,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "render/gpu_scene.h"
 
 #include <glm/glm.hpp>
 
@@ -30,62 +31,11 @@ namespace {
 
 constexpr uint32_t kSets = 3;  // candidates / temporal / spatial rotate through three sets
 
-// The scene's lights for the shaders. (The same conversion as the path tracer's; it lives in
-// path_tracer.cpp's anonymous namespace, so it is repeated here until it moves to a shared place.)
-std::vector<shared::GpuLight> restirLights(const Scene& scene) {
-  std::vector<shared::GpuLight> out;
-  for (const Light& l : scene.lights) {
-    shared::GpuLight g{};
-    switch (l.type) {
-      case LightType::Sun: {
-        g.dirOrPos = glm::vec4(glm::normalize(l.toLight), 0.0f);
-        const double alpha = glm::radians(double(l.angularRadiusDeg));
-        const double s2 = std::sin(alpha) * std::sin(alpha);
-        g.emission = glm::vec4(alpha > 0 ? glm::vec3(glm::dvec3(l.irradiance) / (M_PI * s2)) : l.irradiance, 0.0f);
-        g.params = glm::vec4(float(shared::LIGHT_SUN), alpha > 0 ? float(std::cos(alpha)) : 1.0f, 0.0f, 0.0f);
-        break;
-      }
-      case LightType::Point:
-        g.dirOrPos = glm::vec4(l.position, 1.0f);
-        g.emission = glm::vec4(l.intensity, 0.0f);
-        g.params = glm::vec4(float(shared::LIGHT_POINT), 0.0f, 0.0f, 0.0f);
-        break;
-      case LightType::Environment:
-        g.emission = glm::vec4(l.radiance * l.scale, 0.0f);
-        g.params = glm::vec4(float(shared::LIGHT_ENVIRONMENT), 0.0f, 0.0f, 0.0f);
-        break;
-    }
-    out.push_back(g);
-  }
-  if (out.size() > size_t(shared::GPU_MAX_LIGHTS)) {
-    throw InputError(scene.path + strf(": lights: at most %d lights are supported", shared::GPU_MAX_LIGHTS));
-  }
-  if (out.empty()) out.push_back(shared::GpuLight{});
-  return out;
-}
-
-void cameraVectors(const Camera& cam, int frame, glm::vec4 out[4]) {
-  const CameraPose pose = cam.poseAt(frame);
-  const glm::vec3 forward = glm::normalize(pose.lookAt - pose.position);
-  const glm::vec3 right = glm::normalize(glm::cross(forward, pose.up));
-  const glm::vec3 up = glm::cross(right, forward);
-  out[0] = glm::vec4(pose.position, float(std::tan(glm::radians(double(pose.fovY)) * 0.5)));
-  out[1] = glm::vec4(forward, float(cam.width) / float(cam.height));
-  out[2] = glm::vec4(right, 0.0f);
-  out[3] = glm::vec4(up, 0.0f);
-}
-
 }  // namespace
 
 Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene, const RestirOptions& options)
     : ctx_(ctx), scene_(scene), options_(options), features_(featuresOf(scene)), timer_(ctx, 32) {
-  if (!scene.surfaces.empty()) throw InputError(scene.path + ": surfaces: not supported by ReSTIR yet");
-  for (size_t i = 0; i < scene.media.size(); ++i) {
-    if (scene.media[i].emission) throw InputError(scene.path + strf(": media[%zu].emission: not supported yet", i));
-  }
-  for (size_t i = 0; i < scene.lights.size(); ++i) {
-    if (!scene.lights[i].map.empty()) throw InputError(scene.path + strf(": lights[%zu].map: not supported yet", i));
-  }
+  checkGpuSupports(scene, "ReSTIR");
   if (scene.render.maxBounces > int(shared::RS_MAX_VERTICES)) {
     throw InputError(scene.path + strf(": render.max_bounces: ReSTIR stores paths of at most %u vertices (got %d); "
                                        "use mode pt for longer paths",
@@ -119,7 +69,7 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   const size_t pixels = size_t(scene.camera.width) * scene.camera.height;
   const uint32_t stride = uint32_t(std::max(1, scene.render.maxBounces - 1));
   frameBuffer_ = gpu::Buffer(ctx, sizeof(shared::GpuFrame), storage, "frame parameters");
-  std::vector<shared::GpuLight> lights = restirLights(scene);
+  std::vector<shared::GpuLight> lights = gpuLights(scene);
   lightBuffer_ = gpu::Buffer(ctx, lights.size() * sizeof(shared::GpuLight), storage, "lights");
   lightBuffer_.upload(lights.data(), lights.size() * sizeof(shared::GpuLight));
   paramBuffer_ = gpu::Buffer(ctx, sizeof(shared::RestirParams), storage, "restir parameters");
@@ -163,7 +113,7 @@ void Restir::resetHistory() { hasHistory_ = false; }
 void Restir::fillFrame(int frame, uint32_t sequence, uint32_t key) {
   const Camera& cam = scene_.camera;
   glm::vec4 c[4];
-  cameraVectors(cam, frame, c);
+  gpuCameraVectors(cam, frame, c);
   const Medium& m = scene_.media.at(0);
   const RenderSettings& rs = scene_.render;
   frame_.camPosition = c[0];

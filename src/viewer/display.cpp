@@ -1,11 +1,9 @@
 #include "viewer/display.h"
 
-#include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/log.h"
 
 #include <glm/glm.hpp>
-#include <png.h>
 
 #include <algorithm>
 #include <cmath>
@@ -108,26 +106,5 @@ std::vector<unsigned char> ImageReadback::pixels(bool bgra) const {
   return rgb;
 }
 
-void writeRgb8Png(const std::string& path, int width, int height, const std::vector<unsigned char>& rgb) {
-  AtomicFile file(path);
-  FILE* fp = std::fopen(file.tempPath().c_str(), "wb");
-  if (!fp) throw InputError(strf("%s: cannot write PNG", path.c_str()));
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
-  png_infop info = png_create_info_struct(png);
-  if (setjmp(png_jmpbuf(png))) {
-    png_destroy_write_struct(&png, &info);
-    std::fclose(fp);
-    throw InputError(strf("%s: cannot write PNG", path.c_str()));
-  }
-  png_init_io(png, fp);
-  png_set_IHDR(png, info, width, height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
-               PNG_FILTER_TYPE_DEFAULT);
-  png_write_info(png, info);
-  for (int y = 0; y < height; ++y) png_write_row(png, const_cast<unsigned char*>(rgb.data() + 3 * size_t(y) * width));
-  png_write_end(png, nullptr);
-  png_destroy_write_struct(&png, &info);
-  if (std::fclose(fp) != 0) throw InputError(strf("%s: cannot write PNG", path.c_str()));
-  file.commit();
-}
 
 }  // namespace plume::viewer

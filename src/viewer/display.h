@@ -48,6 +48,5 @@ class ImageReadback {
 };
 
 // An 8-bit RGB PNG from raw pixels (the window as shown; no tone mapping). Throws InputError.
-void writeRgb8Png(const std::string& path, int width, int height, const std::vector<unsigned char>& rgb);
 
 }  // namespace plume::viewer

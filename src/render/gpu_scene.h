@@ -1,0 +1,26 @@
+// The scene as the GPU estimators see it: lights and camera vectors in the shared GPU layout
+// (shaders/shared/gpu_types.h), and the check of what the GPU renderers support. Shared by the
+// path tracer and ReSTIR so that both render the same scene.
+#pragma once
+
+#include "scene/scene.h"
+#include "shaders/shared/gpu_types.h"
+
+#include <string>
+#include <vector>
+
+namespace plume {
+
+// Throws InputError naming the scene key for features the GPU renderers lack (surfaces,
+// emission, environment maps); `renderer` names the renderer in the message.
+void checkGpuSupports(const Scene& scene, const std::string& renderer);
+
+// The scene's lights for the shaders (never empty: one zero light when the scene has none).
+// Throws InputError for more than GPU_MAX_LIGHTS lights.
+std::vector<shared::GpuLight> gpuLights(const Scene& scene);
+
+// Camera of `frame` as GpuFrame's four vectors: position (w: tan(fovY/2)), forward (w: aspect),
+// right, up (DESIGN §2: right = normalize(cross(forward, up)), row 0 at the top).
+void gpuCameraVectors(const Camera& cam, int frame, glm::vec4 out[4]);
+
+}  // namespace plume
