@@ -60,7 +60,16 @@ int runRestirRender(const RenderArgs& a, const Scene& scene) {
   Restir restir(ctx, compiler, scene, restirOptionsOf(rs));
   const Medium& medium = scene.media.at(0);
   std::unique_ptr<GpuVolumeResources> prev;
-  for (int frame = rs.frameFirst; frame <= rs.frameLast; ++frame) {
+  // Pre-roll frames (before render.frames' first) warm the reservoirs and are not written. A frame
+  // skipped by --resume breaks the history: the next rendered frame starts cold.
+  const int warmFrom = prerollRange(scene, a.preroll).first;
+  for (int frame = warmFrom; frame <= rs.frameLast; ++frame) {
+    const bool warmOnly = frame < rs.frameFirst;
+    if (!warmOnly && a.outputs.skip(frame, rs)) {
+      restir.resetHistory();
+      prev.reset();
+      continue;
+    }
     const auto start = std::chrono::steady_clock::now();
     LoadedGrid grid = loadFloatGrid(medium.vdbPath(frame), medium.densityGrid);
     auto volume = std::make_unique<GpuVolumeResources>(ctx, bakeVolume(grid, bakeOptions), medium.densityScale);
@@ -80,6 +89,10 @@ int runRestirRender(const RenderArgs& a, const Scene& scene) {
       sum.var[k] = n > 1 ? float(std::max(0.0, s2[k] / n - (s1[k] / n) * (s1[k] / n)) / (n - 1)) : 0.0f;
     }
     prev = std::move(volume);
+    if (warmOnly) {
+      if (!a.quiet) logInfo(strf("frame %d: pre-roll (not written)", frame));
+      continue;
+    }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     sum.meta["version"] = PLUME_VERSION;
     sum.meta["mode"] = rs.mode;
@@ -121,10 +134,6 @@ int runRender(const RenderArgs& a) {
   }
   const int toRender = int(todo.size());
   FrameProgress progress(toRender, rs.spp, !a.quiet);
-  // Pre-roll hook: frames [first, last] of prerollRange are to be rendered into the estimator's
-  // history and not written; empty for the path tracer.
-  const auto [prerollFirst, prerollLast] = prerollRange(scene, a.preroll);
-  if (prerollLast >= prerollFirst) logInfo(strf("pre-roll: frames %d-%d", prerollFirst, prerollLast));
   for (int frame : todo) {
     const auto start = std::chrono::steady_clock::now();
     progress.beginFrame(frame);
