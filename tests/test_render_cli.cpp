@@ -145,3 +145,26 @@ TEST(RenderCli, PrerollIsAcceptedAndANoOpForThePathTracer) {
   EXPECT_EQ(readExr(dir + "/p.exr").rgb, readExr(dir + "/q.exr").rgb);
   EXPECT_EQ(with({"--preroll", "-1"}, "r.exr").exitCode, 2);
 }
+
+TEST(RenderCli, RestirPrerollWarmsWithoutWritingAndIsDeterministic) {
+  const std::string dir = test::outputDir("render_cli_restir");
+  auto run = [&](const std::string& sub, const std::string& preroll) {
+    std::filesystem::create_directories(dir + "/" + sub);
+    test::RunResult r = test::runPlume({"render", kScene, "--mode", "restir", "-o", dir + "/" + sub + "/f_{frame:04}.exr",
+                                        "--frames", "5-6", "--width", "32", "--height", "32", "--spp", "2",
+                                        "--preroll", preroll});
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    return r.output;
+  };
+  const std::string out = run("a", "2");
+  EXPECT_NE(out.find("frame 3: pre-roll"), std::string::npos) << out;
+  EXPECT_NE(out.find("frame 4: pre-roll"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(framePath(dir + "/a", 3)));
+  EXPECT_FALSE(std::filesystem::exists(framePath(dir + "/a", 4)));
+  run("b", "2");
+  run("c", "0");
+  Image a = readExr(framePath(dir + "/a", 6)), b = readExr(framePath(dir + "/b", 6)), c = readExr(framePath(dir + "/c", 6));
+  EXPECT_EQ(a.meta["mode"], "restir");
+  EXPECT_EQ(a.rgb, b.rgb) << "same seed, same pre-roll: same pixels";
+  EXPECT_NE(a.rgb, c.rgb) << "the pre-roll must change the history the frame starts from";
+}
