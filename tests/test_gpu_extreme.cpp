@@ -6,6 +6,7 @@
 #include "reference/reference.h"
 #include "support/gpu_fixture.h"
 #include "support/grids.h"
+#include "support/scenes.h"
 #include "support/test_support.h"
 
 #include <glm/glm.hpp>
@@ -30,15 +31,7 @@ Scene sceneFor(double size, int pixels) {
   s.camera.width = s.camera.height = pixels;
   s.media.push_back(Medium{});
   s.media[0].albedo = glm::vec3(0.9f);
-  Light sun;
-  sun.type = LightType::Sun;
-  sun.toLight = glm::normalize(glm::vec3(0.3f, 1.0f, -0.4f));
-  sun.irradiance = glm::vec3(3.0f);
-  s.lights.push_back(sun);
-  Light env;
-  env.type = LightType::Environment;
-  env.radiance = {0.1f, 0.12f, 0.15f};
-  s.lights.push_back(env);
+  s.lights = {test::sunLight({0.3f, 1.0f, -0.4f}, glm::vec3(3.0f)), test::skyLight({0.1f, 0.12f, 0.15f})};
   s.render.maxBounces = 6;
   return s;
 }

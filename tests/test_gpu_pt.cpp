@@ -7,6 +7,7 @@
 #include "render/path_tracer.h"
 #include "support/gpu_fixture.h"
 #include "support/grids.h"
+#include "support/scenes.h"
 #include "support/test_support.h"
 
 #include <glm/glm.hpp>
@@ -25,15 +26,7 @@ Scene baseScene(glm::vec3 position, glm::vec3 lookAt, int size) {
   s.camera.base.fovY = 40.0f;
   s.camera.width = s.camera.height = size;
   s.media.push_back(Medium{});
-  Light sun;
-  sun.type = LightType::Sun;
-  sun.toLight = glm::normalize(glm::vec3(0.4f, 1.0f, 0.3f));
-  sun.irradiance = {3.0f, 2.8f, 2.5f};
-  s.lights.push_back(sun);
-  Light env;
-  env.type = LightType::Environment;
-  env.radiance = {0.10f, 0.12f, 0.16f};
-  s.lights.push_back(env);
+  s.lights = {test::sunLight({0.4f, 1.0f, 0.3f}, {3.0f, 2.8f, 2.5f}), test::skyLight({0.10f, 0.12f, 0.16f})};
   return s;
 }
 

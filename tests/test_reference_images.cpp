@@ -8,6 +8,7 @@
 #include "reference/reference.h"
 #include "shaders/shared/phase.h"
 #include "support/grids.h"
+#include "support/scenes.h"
 #include "support/test_support.h"
 
 #include <glm/glm.hpp>
@@ -184,15 +185,7 @@ TEST(ReferenceImages, VarianceImageMatchesSpreadBetweenSeeds) {
   s.media[0].densityScale = 6.0f;
   s.media[0].albedo = glm::vec3(0.9f);
   s.media[0].g = 0.3f;
-  Light sun;
-  sun.type = LightType::Sun;
-  sun.toLight = glm::normalize(glm::vec3(0.5f, 1.0f, 0.3f));
-  sun.irradiance = glm::vec3(3.0f);
-  s.lights.push_back(sun);
-  Light env;
-  env.type = LightType::Environment;
-  env.radiance = {0.1f, 0.12f, 0.15f};
-  s.lights.push_back(env);
+  s.lights = {test::sunLight({0.5f, 1.0f, 0.3f}, glm::vec3(3.0f)), test::skyLight({0.1f, 0.12f, 0.15f})};
   s.render.maxBounces = 8;
   s.render.spp = 64;
   s.render.seed = 1;

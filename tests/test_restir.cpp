@@ -11,6 +11,7 @@
 #include "render/restir.h"
 #include "support/gpu_fixture.h"
 #include "support/grids.h"
+#include "support/scenes.h"
 #include "support/test_support.h"
 
 #include <glm/glm.hpp>
@@ -37,15 +38,7 @@ Scene baseScene(int size) {
   m.albedo = glm::vec3(0.8f, 0.85f, 0.9f);
   m.g = 0.4f;
   s.media.push_back(m);
-  Light sun;
-  sun.type = LightType::Sun;
-  sun.toLight = glm::normalize(glm::vec3(0.4f, 1.0f, 0.3f));
-  sun.irradiance = {3.0f, 2.8f, 2.5f};
-  s.lights.push_back(sun);
-  Light env;
-  env.type = LightType::Environment;
-  env.radiance = {0.10f, 0.12f, 0.16f};
-  s.lights.push_back(env);
+  s.lights = {test::sunLight({0.4f, 1.0f, 0.3f}, {3.0f, 2.8f, 2.5f}), test::skyLight({0.10f, 0.12f, 0.16f})};
   s.render.maxBounces = 1;
   return s;
 }
