@@ -118,3 +118,21 @@ TEST_F(GpuExtremeMedia, VeryDenseHighAlbedoMedium) {
   s.render.maxBounces = 4;
   expectMatch(ctx(), compiler(), s, grid, "very_dense");
 }
+
+TEST_F(GpuExtremeMedia, SunWithADiskMatchesReferenceAndTheDeltaSun) {
+  // The real sun's 0.27 degrees (1 - cos ~ 1.1e-5, where float cosines lose 0.5%) and a 5 degree
+  // disk. A small disk must also render like the delta sun with the same irradiance.
+  auto grid = test::makeNoiseGrid(32, 1.0 / 16, 25);
+  Scene s = sceneFor(2.0, 16);
+  s.media[0].densityScale = 4.0f;
+  s.lights.resize(1);
+  Image delta = test::renderGpuPt(ctx(), compiler(), [&] { Scene d = s; d.render.spp = 512; return d; }(), grid);
+  for (float radius : {0.2665f, 5.0f}) {
+    s.lights[0].angularRadiusDeg = radius;
+    expectMatch(ctx(), compiler(), s, grid, radius < 1 ? "sun_disk_small" : "sun_disk_5deg");
+  }
+  s.lights[0].angularRadiusDeg = 0.2665f;
+  s.render.spp = 512;
+  Image disk = test::renderGpuPt(ctx(), compiler(), s, grid);
+  EXPECT_NEAR(meanRatio(disk.rgb, delta.rgb), 1.0, 0.01);
+}

@@ -111,8 +111,8 @@ TEST(Sampling, UniformCone) {
   constexpr int kVBins = 20, kPhiBins = 20;
   const int nCones = int(std::size(radii));
   for (int k = 0; k < nCones; ++k) {
-    const float cosMax = std::cos(float(radii[k]));
-    const double vMax = 1.0 - double(cosMax);  // the cone the sampler is asked for
+    const float vMaxF = float(2.0 * std::sin(0.5 * radii[k]) * std::sin(0.5 * radii[k]));  // 1 - cos
+    const double vMax = double(vMaxF);  // the cone the sampler is asked for
     // Uniform in solid angle = uniform in v = 1 - cosTheta on [0, vMax] and in phi; one extra
     // bin of expected count 0 collects directions outside the cone.
     std::vector<double> observed(kVBins * kPhiBins + 1, 0.0);
@@ -120,7 +120,7 @@ TEST(Sampling, UniformCone) {
     expected.back() = 0.0;
     RngState rng = rng_init(uvec2(uint(k), 2u), 0u, RNG_STREAM_TEST, 33u);
     for (int s = 0; s < kSamples; ++s) {
-      const dvec3 d = dvec3(smp_uniform_cone(axes[k], cosMax, rng_float2(rng)));
+      const dvec3 d = dvec3(smp_uniform_cone(axes[k], vMaxF, rng_float2(rng)));
       ASSERT_NEAR(glm::length(d), 1.0, 1e-5);
       const Polar p = polarAround(dvec3(axes[k]), d);
       const double x = p.v / vMax;
@@ -134,7 +134,10 @@ TEST(Sampling, UniformCone) {
 
 TEST(Sampling, ConeOfZeroRadiusIsTheAxis) {
   const vec3 axis = normalize(vec3(1.0f, 2.0f, 3.0f));
-  const vec3 d = smp_uniform_cone(axis, 1.0f, vec2(0.3f, 0.7f));
+  const vec3 d = smp_uniform_cone(axis, 0.0f, vec2(0.3f, 0.7f));
   EXPECT_NEAR(dot(d, axis), 1.0f, 1e-6f);
   EXPECT_NEAR(smp_uniform_cone_pdf(0.5f), 1.0 / kPi, 1e-6);
+  // The versine keeps its precision where 1 - dot does not (the sun's 0.27 degrees).
+  const vec3 b = smp_uniform_cone(axis, 1.1e-5f, vec2(1.0f, 0.25f));
+  EXPECT_NEAR(smp_versine(axis, b), 1.1e-5f, 1e-9f);
 }

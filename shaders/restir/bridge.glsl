@@ -53,8 +53,9 @@ bool rs_light_geometry(GpuLight l, vec3 x, vec2 ls, out vec3 w, out float dist, 
   dist = DDA_INF;
   Le = l.emission.rgb;
   if (type == LIGHT_SUN) {
-    w = l.params.y >= 1.0f ? l.dirOrPos.xyz : rs_decode_dir(ls);
-    return l.params.y >= 1.0f || dot(w, l.dirOrPos.xyz) >= l.params.y;
+    // A disk: the stored direction must lie in the cone (up to its float encoding's rounding).
+    w = l.params.y <= 0.0f ? l.dirOrPos.xyz : rs_decode_dir(ls);
+    return l.params.y <= 0.0f || smp_versine(w, l.dirOrPos.xyz) <= l.params.y * 1.001f;
   }
   if (type == LIGHT_POINT) {
     vec3 toL = l.dirOrPos.xyz - x;
@@ -79,10 +80,10 @@ float rs_sample_light(vec3 wIn, float g, vec3 u, out uint light, out vec2 ls) {
   float pdf = 1.0f / float(n);
   ls = vec2(0.0f);
   if (type == LIGHT_SUN) {
-    if (l.params.y >= 1.0f) return pdf;
+    if (l.params.y <= 0.0f) return pdf;
     ls = rs_encode_dir(smp_uniform_cone(l.dirOrPos.xyz, l.params.y, u.yz));
     vec3 w = rs_decode_dir(ls);
-    return dot(w, l.dirOrPos.xyz) >= l.params.y ? pdf * smp_uniform_cone_pdf(l.params.y) : 0.0f;
+    return smp_versine(w, l.dirOrPos.xyz) <= l.params.y * 1.001f ? pdf * smp_uniform_cone_pdf(l.params.y) : 0.0f;
   }
   if (type == LIGHT_POINT) return pdf;
   ls = rs_encode_dir(ph_hg_sample(wIn, g, u.yz));

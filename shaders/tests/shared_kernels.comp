@@ -21,7 +21,7 @@ struct KernelResult {
   uvec4 rng1;
   vec4 phase;   // x: ph_hg(cos, g), y: ph_hg_sample_cos(g, u), z: vol_density(point)
   vec4 hgDir;   // ph_hg_sample(wi, g, u2)
-  vec4 coneDir; // smp_uniform_cone(wi, 0.9, u2)
+  vec4 coneDir; // smp_uniform_cone(wi, 0.1, u2)
 };
 
 layout(std430, binding = 5) readonly buffer Cases { KernelCase cases[]; };
@@ -40,6 +40,6 @@ void main() {
   vec2 u = rng_float2(r);
   o.phase = vec4(ph_hg(c.dir.w, g), ph_hg_sample_cos(g, u.x), vol_density(c.point.xyz), 0.0f);
   o.hgDir = vec4(ph_hg_sample(c.dir.xyz, g, u), 0.0f);
-  o.coneDir = vec4(smp_uniform_cone(c.dir.xyz, 0.9f, u), 0.0f);
+  o.coneDir = vec4(smp_uniform_cone(c.dir.xyz, 0.1f, u), 0.0f);
   results[i] = o;
 }

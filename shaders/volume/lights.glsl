@@ -12,14 +12,14 @@ vec3 light_direct(GpuLight l, vec3 x, vec3 rayDir, float g, inout RngState rng) 
   uint type = uint(l.params.x);
 #ifdef PLUME_HAS_SUN
   if (type == LIGHT_SUN) {
-    float cosMax = l.params.y;
-    if (cosMax >= 1.0f) {
+    float vMax = l.params.y;  // 1 - cos(angular radius); 0: a delta direction
+    if (vMax <= 0.0f) {
       vec3 w = l.dirOrPos.xyz;
       return l.emission.rgb * ph_hg(dot(w, rayDir), g) * vol_ratio_tracking(x, w, DDA_INF, rng);
     }
-    vec3 w = smp_uniform_cone(l.dirOrPos.xyz, cosMax, rng_float2(rng));
+    vec3 w = smp_uniform_cone(l.dirOrPos.xyz, vMax, rng_float2(rng));
     float tr = vol_ratio_tracking(x, w, DDA_INF, rng);
-    return l.emission.rgb * ph_hg(dot(w, rayDir), g) * tr / smp_uniform_cone_pdf(cosMax);
+    return l.emission.rgb * ph_hg(dot(w, rayDir), g) * tr / smp_uniform_cone_pdf(vMax);
   }
 #endif
 #ifdef PLUME_HAS_POINT

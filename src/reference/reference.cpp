@@ -26,7 +26,7 @@ namespace sh = plume::shared;
 struct PreparedLight {
   LightType type;
   dvec3 dir{0};         // sun: unit vector towards the sun
-  double cosMax = 1.0;  // sun: cone of the disk; 1 = delta direction
+  float versine = 0.0f;  // sun: the disk's 1 - cos(angular radius); 0 = a delta direction
   dvec3 radiance{0};    // sun with a disk: L = E / (pi sin^2 alpha); environment: L
   dvec3 irradiance{0};  // delta sun
   dvec3 position{0};    // point
@@ -56,7 +56,7 @@ std::vector<PreparedLight> prepareLights(const Scene& scene) {
         p.dir = glm::normalize(toD(l.toLight));
         double alpha = glm::radians(double(l.angularRadiusDeg));
         if (alpha > 0) {
-          p.cosMax = std::cos(alpha);
+          p.versine = float(2.0 * std::sin(0.5 * alpha) * std::sin(0.5 * alpha));
           double sin2 = std::sin(alpha) * std::sin(alpha);
           p.radiance = toD(l.irradiance) / (M_PI * sin2);
         } else {
@@ -89,14 +89,14 @@ dvec3 estimateDirect(const Context& c, const dvec3& x, const dvec3& rayDir, Pcg3
   for (const PreparedLight& l : c.lights) {
     switch (l.type) {
       case LightType::Sun: {
-        if (l.cosMax >= 1.0) {
+        if (l.versine <= 0.0f) {
           double tr = c.medium->ratioTracking({x, l.dir}, inf, rng, acc, *c.tracking);
           sum += l.irradiance * phase(glm::dot(l.dir, rayDir), c.g) * tr;
         } else {
           glm::vec2 u(rng.uniform(), rng.uniform());
-          dvec3 w = dvec3(sh::smp_uniform_cone(glm::vec3(l.dir), float(l.cosMax), u));
+          dvec3 w = dvec3(sh::smp_uniform_cone(glm::vec3(l.dir), l.versine, u));
           double tr = c.medium->ratioTracking({x, w}, inf, rng, acc, *c.tracking);
-          double pdf = 1.0 / (2.0 * M_PI * (1.0 - l.cosMax));
+          double pdf = 1.0 / (2.0 * M_PI * double(l.versine));
           sum += l.radiance * phase(glm::dot(w, rayDir), c.g) * tr / pdf;
         }
         break;

@@ -30,10 +30,11 @@ std::vector<shared::GpuLight> gpuLights(const Scene& scene) {
         if (alpha > 0) {
           // A disk of uniform radiance L with irradiance E: E = L * pi * sin^2(alpha).
           g.emission = glm::vec4(glm::dvec3(l.irradiance) / (M_PI * std::sin(alpha) * std::sin(alpha)), 0.0f);
-          g.params = glm::vec4(float(shared::LIGHT_SUN), float(std::cos(alpha)), 0.0f, 0.0f);
+          const double versine = 2.0 * std::sin(0.5 * alpha) * std::sin(0.5 * alpha);  // 1 - cos(alpha)
+          g.params = glm::vec4(float(shared::LIGHT_SUN), float(versine), 0.0f, 0.0f);
         } else {
           g.emission = glm::vec4(l.irradiance, 0.0f);
-          g.params = glm::vec4(float(shared::LIGHT_SUN), 1.0f, 0.0f, 0.0f);
+          g.params = glm::vec4(float(shared::LIGHT_SUN), 0.0f, 0.0f, 0.0f);
         }
         break;
       }

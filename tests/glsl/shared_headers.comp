@@ -48,8 +48,8 @@ void main() {
             ph_hg_sample_cos_sin2(0.9f, u.y, sin2Theta) + sin2Theta;
   // sampling.h
   float t = smp_exponential(2.0f, u0 * 0.25f);
-  vec3 s = smp_uniform_sphere(u) + smp_uniform_cone(wo, 0.9f, u);
-  float pc = smp_uniform_cone_pdf(0.9f);
+  vec3 s = smp_uniform_sphere(u) + smp_uniform_cone(wo, 0.1f, u);
+  float pc = smp_uniform_cone_pdf(0.1f) + smp_versine(wo, s);
   // reservoir.h
   RsReservoir r = rs_empty();
   bool picked = rs_stream(r, p, pc, 0.5f, u.x);
