@@ -70,4 +70,8 @@ class Image3D {
   size_t texelBytes_ = 0;
 };
 
+// A layout transition of a whole single-mip colour image.
+void imageBarrier(VkCommandBuffer cmd, VkImage image, VkImageLayout from, VkImageLayout to, VkAccessFlags srcAccess,
+                  VkAccessFlags dstAccess, VkPipelineStageFlags srcStage, VkPipelineStageFlags dstStage);
+
 }  // namespace plume::gpu

@@ -68,4 +68,22 @@ void gpuCameraVectors(const Camera& cam, int frame, glm::vec4 out[4]) {
   out[3] = glm::vec4(up, 0.0f);
 }
 
+shared::GpuFrame gpuFrame(const Scene& scene, int frame, uint32_t seed, uint32_t frameKey, uint32_t sppPerDispatch) {
+  const Camera& cam = scene.camera;
+  const Medium& m = scene.media.at(0);
+  const RenderSettings& rs = scene.render;
+  glm::vec4 c[4];
+  gpuCameraVectors(cam, frame, c);
+  shared::GpuFrame f{};
+  f.camPosition = c[0];
+  f.camForward = c[1];
+  f.camRight = c[2];
+  f.camUp = c[3];
+  f.albedo = glm::vec4(m.albedo, m.g);
+  f.image = glm::uvec4(uint32_t(cam.width), uint32_t(cam.height), sppPerDispatch, uint32_t(rs.maxBounces));
+  f.seeds = glm::uvec4(seed, frameKey, 0u, uint32_t(rs.rrStartBounce));
+  f.lights = glm::uvec4(uint32_t(scene.lights.size()), 0u, 0u, 0u);
+  return f;
+}
+
 }  // namespace plume

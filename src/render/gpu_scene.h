@@ -23,4 +23,8 @@ std::vector<shared::GpuLight> gpuLights(const Scene& scene);
 // right, up (DESIGN §2: right = normalize(cross(forward, up)), row 0 at the top).
 void gpuCameraVectors(const Camera& cam, int frame, glm::vec4 out[4]);
 
+// GpuFrame of `frame`: camera, medium, image size, bounces and light count from the scene;
+// the random-stream seed and frame key, and the samples per dispatch, from the caller.
+shared::GpuFrame gpuFrame(const Scene& scene, int frame, uint32_t seed, uint32_t frameKey, uint32_t sppPerDispatch);
+
 }  // namespace plume

@@ -86,19 +86,7 @@ void PathTracer::setVolume(const GpuVolumeResources& volume) {
 }
 
 void PathTracer::beginFrame(int frame) {
-  const Camera& cam = scene_.camera;
-  const Medium& m = scene_.media.at(0);
-  const RenderSettings& rs = scene_.render;
-  glm::vec4 c[4];
-  gpuCameraVectors(cam, frame, c);
-  frame_.camPosition = c[0];
-  frame_.camForward = c[1];
-  frame_.camRight = c[2];
-  frame_.camUp = c[3];
-  frame_.albedo = glm::vec4(m.albedo, m.g);
-  frame_.image = glm::uvec4(uint32_t(cam.width), uint32_t(cam.height), 0u, uint32_t(rs.maxBounces));
-  frame_.seeds = glm::uvec4(uint32_t(rs.seed), uint32_t(frame), 0u, uint32_t(rs.rrStartBounce));
-  frame_.lights = glm::uvec4(uint32_t(scene_.lights.size()), 0u, 0u, 0u);
+  frame_ = gpuFrame(scene_, frame, uint32_t(scene_.render.seed), uint32_t(frame), 0u);
   accum_.fillZero();
   samples_ = 0;
 }

@@ -111,19 +111,8 @@ void Restir::setVolumes(const GpuVolumeResources& current, const GpuVolumeResour
 void Restir::resetHistory() { hasHistory_ = false; }
 
 void Restir::fillFrame(int frame, uint32_t sequence, uint32_t key) {
-  const Camera& cam = scene_.camera;
-  glm::vec4 c[4];
-  gpuCameraVectors(cam, frame, c);
-  const Medium& m = scene_.media.at(0);
-  const RenderSettings& rs = scene_.render;
-  frame_.camPosition = c[0];
-  frame_.camForward = c[1];
-  frame_.camRight = c[2];
-  frame_.camUp = c[3];
-  frame_.albedo = glm::vec4(m.albedo, m.g);
-  frame_.image = glm::uvec4(uint32_t(cam.width), uint32_t(cam.height), 1u, uint32_t(rs.maxBounces));
-  frame_.seeds = glm::uvec4(uint32_t(rs.seed) + 0x9E3779B9u * sequence, key, 0u, uint32_t(rs.rrStartBounce));
-  frame_.lights = glm::uvec4(uint32_t(scene_.lights.size()), 0u, 0u, 0u);
+  frame_ = gpuFrame(scene_, frame, uint32_t(scene_.render.seed) + 0x9E3779B9u * sequence, key, 1u);
+  const glm::vec4 c[4] = {frame_.camPosition, frame_.camForward, frame_.camRight, frame_.camUp};
   const bool history = hasHistory_ && options_.historyCap > 0 && prevSequence_ == sequence;
   if (history) {
     params_.prevCamPosition = prevCam_[0];
