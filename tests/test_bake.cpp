@@ -350,5 +350,42 @@ TEST(Bake, CoarseMeanIsTheCellAverageOfTheTrilinearField) {
   EXPECT_GT(positive, 100);
 }
 
+// coarse1Residual bounds |d(p) - coarse1Mean| over each cell (residual ratio tracking needs it
+// for low variance) and is tight: the largest deviation of random points comes within 40% of
+// it (a trilinear field's extremes lie on the 3³ texels, which random points only approach).
+TEST(Bake, CoarseResidualBoundsTheFieldAroundTheMean) {
+  for (const TexelFormat format : {TexelFormat::Float32, TexelFormat::Float16}) {
+    BakeOptions options;
+    options.format = format;
+    const BakedVolume vol = bakeVolume(wrap(makeNoisyGrid()), options);
+    ASSERT_EQ(vol.coarse1Residual.size(), size_t(vol.slotCount) * 64);
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    int cells = 0, tight = 0;
+    for (int bz = 0; bz < vol.brickDims.z; ++bz)
+      for (int by = 0; by < vol.brickDims.y; ++by)
+        for (int bx = 0; bx < vol.brickDims.x; ++bx) {
+          const glm::ivec3 brick = vol.brickOrigin + glm::ivec3(bx, by, bz);
+          const uint32_t slot = brickSlot(vol, brick);
+          if (slot == 0) continue;
+          for (int c = 0; c < 64; ++c) {
+            const glm::ivec3 cell(c % 4, (c / 4) % 4, c / 16);
+            const glm::vec3 lo = glm::vec3(brick * kBrickVoxels + 2 * cell);
+            const double mean = vol.coarse1Mean[size_t(slot) * 64 + size_t(c)];
+            const double bound = vol.coarse1Residual[size_t(slot) * 64 + size_t(c)];
+            double worst = 0;
+            for (int k = 0; k < 64; ++k) {
+              const glm::vec3 p = lo + 2.0f * glm::vec3(u(rng), u(rng), u(rng));
+              worst = std::max(worst, std::abs(double(sampleDensity(vol, p)) - mean));
+            }
+            ASSERT_LE(worst, bound) << "brick " << bx << "," << by << "," << bz << " cell " << c;
+            if (bound > 0) ++cells, tight += worst > 0.6 * bound;
+          }
+        }
+    EXPECT_GT(cells, 1000);
+    EXPECT_GT(tight, cells / 2) << "the bound is loose in most cells";
+  }
+}
+
 }  // namespace
 }  // namespace plume

@@ -238,6 +238,29 @@ TEST_F(GpuRestir, TemporalAndSpatialStillCameraMatchesReference) {
   expectMatches(run, reference(s, grid, 512), "temporal_still");
 }
 
+// More than four lights: each candidate vertex samples one light chosen in proportion to its
+// estimated power (render/restir.cpp) instead of every light; a dim light must still be found.
+TEST_F(GpuRestir, ManyLightsChosenByPowerMatchReference) {
+  Scene s = baseScene(16);
+  auto point = [](glm::vec3 p, glm::vec3 intensity) {
+    Light l;
+    l.type = LightType::Point;
+    l.position = p;
+    l.intensity = intensity;
+    return l;
+  };
+  s.lights.push_back(point({2.6f, 1.4f, 1.2f}, {2.0f, 1.0f, 0.5f}));
+  s.lights.push_back(point({-0.4f, 0.8f, 1.6f}, {0.3f, 0.6f, 1.2f}));
+  s.lights.push_back(point({1.0f, 2.6f, 0.4f}, {0.05f, 0.05f, 0.05f}));  // dim: rarely chosen
+  auto grid = test::makeNoiseGrid(40, 1.0 / 20, 2);
+  RestirOptions o;  // temporal + spatial
+  o.radius = 6;
+  RunSpec spec;
+  spec.framesPerRun = 3;
+  RestirRun run = runRestir(ctx(), compiler(), s, o, spec, [&](int) { return grid; });
+  expectMatches(run, reference(s, grid, 512), "many_lights");
+}
+
 TEST_F(GpuRestir, MovingCameraMatchesReferencesOfItsPoses) {
   Scene s = baseScene(16);
   CameraKey key;

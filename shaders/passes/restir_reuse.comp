@@ -17,8 +17,8 @@ void main() {
   uvec2 pixel = gl_GlobalInvocationID.xy;
   if (pixel.x >= frame.image.x || pixel.y >= frame.image.y) return;
   uint index = pixel.y * frame.image.x + pixel.x;
-  RsInputs in_;
   in_.count = 1u;
+  in_.sameDomain = false;
   in_.set[0] = push.sets.x;
   in_.pixel[0] = index;
   in_.domain[0] = rs_current_domain(pixel);
@@ -33,6 +33,7 @@ void main() {
       in_.set[1] = push.sets.y;
       in_.pixel[1] = qi;
       in_.domain[1] = rs_previous_domain(q);
+      in_.sameDomain = rsp.misc.y != 0u && qi == index;
       in_.res[1] = rs_load(push.sets.y, qi);
       rs_cap_confidence(in_.res[1], rsp.configF.y * in_.res[0].M);
       in_.count = 2u;
@@ -52,5 +53,5 @@ void main() {
       in_.res[k] = rs_load(push.sets.x, qi);
     }
   }
-  rs_reuse(in_, rsp.config.z, push.sets.z, index, rng);
+  rs_reuse(rsp.config.z, push.sets.z, index, rng);
 }

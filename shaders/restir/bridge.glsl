@@ -1,5 +1,5 @@
 // The bridge between ReSTIR's algorithm (shared/reservoir.h, shared/restir_types.h) and our
-// resources: domains (a pixel's camera ray in a frame, with that frame's volume), the path
+// resources: domains (a pixel of a frame, with that frame's volume), the path
 // contribution f_D(y) — approximate (the target p̂) or unbiased (final shading) — candidate
 // generation, reservoir storage, and the one reuse step shared by the temporal and spatial passes.
 // Requires restir/bindings.glsl, volume/volume.glsl (unbiased tracking on the current volume)
@@ -11,36 +11,45 @@
 #include "../shared/rng.h"
 #include "../shared/sampling.h"
 
-// A domain of the integral: one pixel's camera ray in one frame and that frame's volume.
+// A domain of the integral: one pixel of one frame (its camera and that frame's volume). The
+// pixel's box filter is part of the path: a path starts with its position (u, v) in [0, 1]² inside
+// the pixel, and the shift copies it, so a still camera's history is the same domain (identity
+// shift, equal targets) and neighbours use the same sub-pixel offset.
 struct RsDomain {
   vec3 origin;
-  vec3 dir;
-  uint v;  // 0: current volume, 1: previous
+  vec3 corner;  // un-normalised direction through the pixel's corner (u, v) = (0, 0)
+  vec3 du;      // its change per unit of u (one pixel to the right)
+  vec3 dv;      // and per unit of v (one pixel down)
+  uint v;       // 0: current volume, 1: previous
 };
 
-// The pixel's camera ray of a frame: jittered inside the pixel (box filter) with a stream that
-// depends on (pixel, frame, seed) only, so every pass and the next frame rebuild the same ray.
-RsDomain rs_camera_domain(uvec2 pixel, uint frameNo, vec4 pos, vec4 fwd, vec4 right, vec4 up, uint v) {
-  RngState rng = rng_init(pixel, frameNo, RNG_STREAM_CAMERA, frame.seeds.x);
-  vec2 u = rng_float2(rng);
-  float sx = (2.0f * (float(pixel.x) + u.x) / float(frame.image.x) - 1.0f) * pos.w * fwd.w;
-  float sy = (1.0f - 2.0f * (float(pixel.y) + u.y) / float(frame.image.y)) * pos.w;
+RsDomain rs_camera_domain(uvec2 pixel, vec4 pos, vec4 fwd, vec4 right, vec4 up, uint v) {
+  float sx = (2.0f * float(pixel.x) / float(frame.image.x) - 1.0f) * pos.w * fwd.w;
+  float sy = (1.0f - 2.0f * float(pixel.y) / float(frame.image.y)) * pos.w;
   RsDomain D;
   D.origin = pos.xyz;
-  D.dir = normalize(fwd.xyz + sx * right.xyz + sy * up.xyz);
+  D.corner = fwd.xyz + sx * right.xyz + sy * up.xyz;
+  D.du = (2.0f / float(frame.image.x)) * pos.w * fwd.w * right.xyz;
+  D.dv = (-2.0f / float(frame.image.y)) * pos.w * up.xyz;
   D.v = v;
   return D;
 }
 
+// The camera ray through the point (u, v) of the domain's pixel.
+vec3 rs_domain_dir(RsDomain D, vec2 uv) { return normalize(D.corner + uv.x * D.du + uv.y * D.dv); }
+
 RsDomain rs_current_domain(uvec2 pixel) {
-  return rs_camera_domain(pixel, frame.seeds.y, frame.camPosition, frame.camForward, frame.camRight,
-                          frame.camUp, 0u);
+  return rs_camera_domain(pixel, frame.camPosition, frame.camForward, frame.camRight, frame.camUp, 0u);
 }
 
 RsDomain rs_previous_domain(uvec2 pixel) {
-  return rs_camera_domain(pixel, rsp.frames.x, rsp.prevCamPosition, rsp.prevCamForward,
-                          rsp.prevCamRight, rsp.prevCamUp, 1u);
+  return rs_camera_domain(pixel, rsp.prevCamPosition, rsp.prevCamForward, rsp.prevCamRight, rsp.prevCamUp, 1u);
 }
+
+// A path's sub-pixel position, stored in RsPathHead.info.w as two 16-bit fixed-point numbers;
+// candidates quantise their draw first, so every domain sees exactly the stored value.
+uint rs_pack_uv(vec2 uv) { return packUnorm2x16(uv); }
+vec2 rs_unpack_uv(uint packed) { return unpackUnorm2x16(packed); }
 
 float rs_luminance(vec3 c) { return (c.x + c.y + c.z) * (1.0f / 3.0f); }
 
@@ -69,15 +78,22 @@ bool rs_light_geometry(GpuLight l, vec3 x, vec2 ls, out vec3 w, out float dist, 
   return true;
 }
 
-// Draws a light sample at x for a path arriving along wIn: light chosen uniformly; the disk
-// uniformly in its cone; the environment by phase sampling. Returns the sample's pdf (in the
-// light's measure, with the 1/nLights choice) or 0.
-float rs_sample_light(vec3 wIn, float g, vec3 u, out uint light, out vec2 ls) {
+// Draws a light sample at x for a path arriving along wIn from light `forced`, or, when forced is
+// RS_CHOOSE_LIGHT, from a light chosen with the probabilities the host stored (params.z, running
+// sums in params.w; render/restir.cpp); the disk uniformly in its cone; the environment by phase
+// sampling. Returns the sample's pdf (in the light's measure, times the light's choice
+// probability unless forced) or 0.
+const uint RS_CHOOSE_LIGHT = 0xFFFFFFFFu;
+float rs_sample_light(uint forced, vec3 wIn, float g, vec3 u, out uint light, out vec2 ls) {
   uint n = rsp.frames.w;
-  light = min(uint(u.x * float(n)), n - 1u);
+  light = forced;
+  if (forced == RS_CHOOSE_LIGHT) {
+    light = 0u;
+    while (light + 1u < n && u.x >= lights[light].params.w) ++light;
+  }
   GpuLight l = lights[light];
   uint type = uint(l.params.x);
-  float pdf = 1.0f / float(n);
+  float pdf = forced == RS_CHOOSE_LIGHT ? l.params.z : 1.0f;
   ls = vec2(0.0f);
   if (type == LIGHT_SUN) {
     if (l.params.y <= 0.0f) return pdf;
@@ -90,10 +106,10 @@ float rs_sample_light(vec3 wIn, float g, vec3 u, out uint light, out vec2 ls) {
   return pdf * ph_hg(dot(rs_decode_dir(ls), wIn), g);
 }
 
-// Transmittance: the coarse deterministic one (target) or ratio tracking on the fine grid of the
-// current volume (unbiased; final shading only).
+// Transmittance: the coarse deterministic one (target) or residual ratio tracking on the fine grid
+// of the current volume against the same coarse field (unbiased; final shading only, v = 0).
 float rs_transmittance(uint v, vec3 x, vec3 w, float dist, bool unbiased, inout RngState rng) {
-  return unbiased ? vol_ratio_tracking(x, w, dist, rng) : rs_coarse_tr(v, x, w, dist);
+  return unbiased ? rs_residual_tr(x, w, dist, rng) : rs_coarse_tr(v, x, w, dist);
 }
 
 // The light term at the path's last vertex x (path arriving along wIn): Le * phase * T.
@@ -127,7 +143,7 @@ void rs_copy_path(uint srcSet, uint srcPixel, uint dstSet, uint dstPixel) {
 }
 
 // --- The path contribution f_D(y) ------------------------------------------------------------
-// y is the path stored at (set, pixel); D any domain. Vertices x_1 = o + t1 d, x_i = x_{i-1} +
+// y is the path stored at (set, pixel); D any domain. Vertices x_1 = o + t1 d(u, v), x_i = x_{i-1} +
 // t_i w_i; f = prod_i [T(x_{i-1}, x_i) sigma_s(x_i)] * prod_{i>=2} phase(w_{i-1}, w_i) * light
 // term, RGB. A vertex with zero density (or outside the volume) makes f = 0: the shift fails.
 vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool unbiased, inout RngState rng) {
@@ -136,7 +152,7 @@ vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool unbiased, 
   if (n == 0u) return vec3(0.0f);
   uint base = rs_bounce_base(set, pixelIndex);
   vec3 x = D.origin;
-  vec3 w = D.dir;
+  vec3 w = rs_domain_dir(D, rs_unpack_uv(h.info.w));
   float t = h.geo.x;
   vec3 f = vec3(1.0f);
   for (uint i = 1u; i <= n; ++i) {

@@ -18,6 +18,10 @@ void rs_generate_candidates(uvec2 pixel, uint pixelIndex, uint outSet) {
   uint maxVertices = min(frame.image.w, RS_MAX_VERTICES);
   float g = frame.albedo.w;
   float q = min(1.0f, plume_max3(frame.albedo.rgb));
+  // Few lights: every vertex ends one candidate per light (as the path tracer's next-event
+  // estimation does), each path set with its own pdf; many lights: one light chosen by power.
+  bool allLights = rsp.misc.x != 0u;
+  uint lightSamples = allLights ? rsp.frames.w : 1u;
   uint base = rs_bounce_base(outSet, pixelIndex);
   RsReservoir r = rs_empty();
   RsPathHead head;
@@ -25,8 +29,9 @@ void rs_generate_candidates(uvec2 pixel, uint pixelIndex, uint outSet) {
   head.info = uvec4(0u);
   vec4 walk[RS_MAX_VERTICES - 1u];
   for (uint m = 0u; m < M; ++m) {
+    uint uv = rs_pack_uv(rng_float2(rng));  // the sub-pixel position: pdf 1 on the pixel
     vec3 x = D.origin;
-    vec3 w = D.dir;
+    vec3 w = rs_domain_dir(D, rs_unpack_uv(uv));
     vec3 f = vec3(1.0f);  // prefix of f_D with coarse transmittance (the target's)
     float pdf = 1.0f;     // prefix of the source pdf
     float t1 = 0.0f;
@@ -34,8 +39,9 @@ void rs_generate_candidates(uvec2 pixel, uint pixelIndex, uint outSet) {
       float t;
       float sigmaC;
       float tau;
-      if (!rs_coarse_sample(x, w, DDA_INF, rng_float(rng), t, sigmaC, tau)) break;
-      float trTarget = rs_coarse_tr(0u, x, w, t);  // the target's transmittance (mean field)
+      float tauMean;
+      if (!rs_coarse_sample(x, w, DDA_INF, rng_float(rng), t, sigmaC, tau, tauMean)) break;
+      float trTarget = exp(-min(tauMean, RS_MAX_TAU));  // the target's transmittance (mean field)
       x += t * w;
       float sigma = rsv_sigma_t(0u, x);
       if (!(sigma > 0.0f)) break;  // f = 0 for this path and every extension of it
@@ -46,16 +52,18 @@ void rs_generate_candidates(uvec2 pixel, uint pixelIndex, uint outSet) {
       } else {
         walk[j - 2u] = vec4(w, t);
       }
-      uvec4 h = rng_next4(rng);
-      uint light;
-      vec2 ls;
-      float pl = rs_sample_light(w, g, vec3(rng_to_float(h.x), rng_to_float(h.y), rng_to_float(h.z)), light, ls);
-      if (pl > 0.0f) {
+      for (uint li = 0u; li < lightSamples; ++li) {
+        uvec4 h = rng_next4(rng);
+        uint light;
+        vec2 ls;
+        float pl = rs_sample_light(allLights ? li : RS_CHOOSE_LIGHT, w, g,
+                                   vec3(rng_to_float(h.x), rng_to_float(h.y), rng_to_float(h.z)), light, ls);
+        if (!(pl > 0.0f)) continue;
         float ph = rs_luminance(f * rs_light_term(0u, light, ls, x, w, false, rng));
         float weight = invM * ph / (pdf * pl);
         if (rs_update(r, weight, ph, 0.0f, rng_to_float(h.w))) {
           head.geo = vec4(t1, ls, 0.0f);
-          head.info = uvec4(j, light, 0u, 0u);
+          head.info = uvec4(j, light, 0u, uv);
           for (uint i = 0u; i + 2u <= j; ++i) rsBounces[base + i] = walk[i];
         }
       }

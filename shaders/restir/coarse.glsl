@@ -16,12 +16,14 @@
 #include "../shared/dda.h"
 
 // Cells of bake.coarse1: 2³ voxels, 4³ per brick. The buffer holds, per atlas slot, the 64
-// conservative (dilated) cell values, for sampling distances, then the 64 trilinear means, for
-// the target's transmittance (render/gpu_volume.cpp).
+// conservative (dilated) cell values, for sampling distances, the 64 trilinear means, for the
+// target's transmittance, and the 64 residual majorants of the means, for final shading
+// (render/gpu_volume.cpp).
 const int RS_COARSE_PER_BRICK = 4;   // cells per brick edge
 const float RS_COARSE_CELL = 2.0f;   // voxels per cell edge
 const uint RS_COARSE_SAMPLING = 0u;  // which field: conservative, for sampling
 const uint RS_COARSE_MEAN = 1u;      // the trilinear mean, for approximate transmittance
+const uint RS_COARSE_RESIDUAL = 2u;  // bound on |fine - mean| in the cell (residual tracking)
 const float RS_MAX_TAU = 80.0f;      // exp(-80) > 0 in float: p̂ stays strictly positive
 
 float rsv_scale(uint v) { return v == 0u ? vol.boundsMin.w : prevVol.boundsMin.w; }
@@ -79,7 +81,7 @@ float rsv_coarse_cell(uint v, ivec3 cell, uint field) {
   ivec3 slots = v == 0u ? vol.atlasSlots.xyz : prevVol.atlasSlots.xyz;
   uint index = (slot & 1023u) + uint(slots.x) * (((slot >> 10u) & 1023u) + uint(slots.y) * (slot >> 20u));
   ivec3 c = cell % RS_COARSE_PER_BRICK;
-  uint i = index * 128u + field * 64u + uint((c.z * RS_COARSE_PER_BRICK + c.y) * RS_COARSE_PER_BRICK + c.x);
+  uint i = index * 192u + field * 64u + uint((c.z * RS_COARSE_PER_BRICK + c.y) * RS_COARSE_PER_BRICK + c.x);
   return v == 0u ? volCoarse[i] : prevCoarse[i];
 }
 
@@ -113,12 +115,15 @@ float rs_coarse_tr(uint v, vec3 xWorld, vec3 wWorld, float tMax) {
 }
 
 // Coarse tracking on the current volume: the first collision in (0, tMax) with pdf
-// sigmaC * exp(-tau); false (probability exp(-tau_c(0, tMax))) when the ray leaves first.
+// sigmaC * exp(-tau); false (probability exp(-tau_c(0, tMax))) when the ray leaves first. The
+// same march sums the mean field's optical depth up to the collision (tauMean, as rs_coarse_tau
+// over (0, t)), the target's transmittance of the segment, so candidates march each segment once.
 bool rs_coarse_sample(vec3 xWorld, vec3 wWorld, float tMax, float u, out float t, out float sigmaC,
-                      out float tau) {
+                      out float tau, out float tauMean) {
   t = tMax;
   sigmaC = 0.0f;
   tau = -log(1.0f - u);
+  tauMean = 0.0f;
   vec3 o;
   vec3 d;
   rsv_ray_to_index(0u, xWorld, wWorld, o, d);
@@ -132,14 +137,55 @@ bool rs_coarse_sample(vec3 xWorld, vec3 wWorld, float tMax, float u, out float t
   while (dda_next(s, a, b, cell)) {
     float sigma = scale * rsv_coarse_cell(0u, cell, RS_COARSE_SAMPLING);
     float dtau = sigma * (b - a);
+    float mean = scale * rsv_coarse_cell(0u, cell, RS_COARSE_MEAN);
     if (sigma > 0.0f && dtau >= left) {
       t = a + left / sigma;
       sigmaC = sigma;
+      tauMean += mean * (t - a);
       return true;
     }
+    tauMean += mean * (b - a);
     left -= dtau;
   }
   return false;
+}
+
+#ifndef PLUME_RS_RESIDUAL_SCALE
+#define PLUME_RS_RESIDUAL_SCALE 1.0f
+#endif
+
+// Unbiased transmittance on the current volume's fine grid by residual ratio tracking (Novák et
+// al. 2014) with the coarse mean field as control: T = exp(-tau_mean) * prod_i (1 - (sigma(x_i) -
+// sigma_mean(x_i)) / mu), the points x_i a Poisson process of rate mu = PLUME_RS_RESIDUAL_SCALE
+// times the cell's residual majorant. Its ratio to the target's exp(-tau_mean) is the product
+// alone, with relative variance exp(int r² / mu) - 1 for the residual r: final shading's f / p̂
+// stays near 1 where the mean field is close to the fine one, at a cost proportional to the
+// residual's optical depth instead of the density's.
+float rs_residual_tr(vec3 xWorld, vec3 wWorld, float tMax, inout RngState rng) {
+  vec3 o;
+  vec3 d;
+  rsv_ray_to_index(0u, xWorld, wWorld, o, d);
+  DdaState s;
+  if (!rsv_coarse_start(0u, o, d, tMax, s)) return 1.0f;
+  float scale = rsv_scale(0u);
+  float tau = 0.0f;
+  float prod = 1.0f;
+  float a;
+  float b;
+  ivec3 cell;
+  while (prod != 0.0f && dda_next(s, a, b, cell)) {
+    float mean = scale * rsv_coarse_cell(0u, cell, RS_COARSE_MEAN);
+    tau += mean * (b - a);
+    float mu = PLUME_RS_RESIDUAL_SCALE * scale * rsv_coarse_cell(0u, cell, RS_COARSE_RESIDUAL);
+    if (!(mu > 0.0f)) continue;
+    float t = a;
+    for (;;) {
+      t -= log(1.0f - rng_float(rng)) / mu;
+      if (!(t < b)) break;
+      prod *= 1.0f - (scale * rsv_density(0u, o + t * d) - mean) / mu;
+    }
+  }
+  return exp(-tau) * prod;
 }
 
 #endif

@@ -16,17 +16,23 @@ struct RsInputs {
   uint pixel[RS_MAX_INPUTS];        // pixel index of each input
   RsDomain domain[RS_MAX_INPUTS];   // its domain (the pixel's ray in its frame, that frame's volume)
   RsReservoir res[RS_MAX_INPUTS];   // its reservoir (confidence already capped)
+  bool sameDomain;                  // inputs 0 and 1 share one domain (still camera and volume)
 };
 
-// p̂ of input s's path in input j's domain (the stored value when j == s).
-float rs_target_in(RsInputs in_, uint s, uint j) {
-  if (j == s) return in_.res[s].p_hat;
+// p̂ of input s's path in input j's domain (the stored value when j == s or when both share
+// the domain: the same deterministic function of the same arguments).
+// The inputs of this invocation's reuse step: one shader-private variable, not a by-value
+// argument (a copy of the whole array per call is what a by-value struct compiles to).
+RsInputs in_;
+
+float rs_target_in(uint s, uint j) {
+  if (j == s || (in_.sameDomain && s <= 1u && j <= 1u)) return in_.res[s].p_hat;
   return rs_target(in_.domain[j], in_.set[s], in_.pixel[s]);
 }
 
 // Resamples the inputs into input 0's domain; writes the reservoir and the selected path to
 // (outSet, outPixel). misKind: RS_MIS_PAIRWISE, RS_MIS_GBH or RS_MIS_BIASED.
-void rs_reuse(RsInputs in_, uint misKind, uint outSet, uint outPixel, inout RngState rng) {
+void rs_reuse(uint misKind, uint outSet, uint outPixel, inout RngState rng) {
   float Msum = 0.0f;
   for (uint s = 0u; s < in_.count; ++s) Msum += in_.res[s].M;
   float Mc = in_.res[0].M;
@@ -38,19 +44,19 @@ void rs_reuse(RsInputs in_, uint misKind, uint outSet, uint outPixel, inout RngS
     float phC = 0.0f;
     float m = 0.0f;
     if (hasSample) {
-      phC = rs_target_in(in_, s, 0u);
+      phC = rs_target_in(s, 0u);
       if (misKind == RS_MIS_BIASED) {
         m = rs_.M / Msum;
       } else if (misKind == RS_MIS_GBH) {
         float denom = 0.0f;
         for (uint j = 0u; j < in_.count; ++j) {
-          denom += in_.res[j].M * (j == 0u ? phC : rs_target_in(in_, s, j));
+          denom += in_.res[j].M * (j == 0u ? phC : rs_target_in(s, j));
         }
         m = rs_gbh(rs_.M, rs_.p_hat, denom);
       } else if (s == 0u) {
         m = Mc / Msum;
         for (uint i = 1u; i < in_.count; ++i) {
-          m += rs_pairwise_canonical_term(in_.res[i].M, rs_target_in(in_, 0u, i), Mc, phC, Msum);
+          m += rs_pairwise_canonical_term(in_.res[i].M, rs_target_in(0u, i), Mc, phC, Msum);
         }
       } else {
         m = rs_pairwise_neighbour(rs_.M, rs_.p_hat, Mc, phC, Msum);

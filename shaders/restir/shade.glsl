@@ -1,7 +1,7 @@
 // Final shading (DESIGN §4.2 step 7): the selected path evaluated once with unbiased
-// transmittance (ratio tracking on the fine grid, every segment and the light ray) times
-// W = w_sum / p̂(Y); plus the environment seen directly through the camera ray (also by ratio
-// tracking), which no reservoir path covers. Requires restir/bridge.glsl.
+// transmittance (residual ratio tracking on the fine grid, every segment and the light ray) times
+// W = w_sum / p̂(Y); plus the environment seen directly through the camera ray (also by residual
+// ratio tracking), which no reservoir path covers. Requires restir/bridge.glsl.
 #ifndef PLUME_RESTIR_SHADE_GLSL
 #define PLUME_RESTIR_SHADE_GLSL
 
@@ -16,7 +16,7 @@ vec3 rs_shade(uvec2 pixel, uint pixelIndex, uint set) {
   for (uint i = 0u; i < rsp.frames.w; ++i) {
     if (uint(lights[i].params.x) == LIGHT_ENVIRONMENT) env += lights[i].emission.rgb;
   }
-  L += env * vol_ratio_tracking(D.origin, D.dir, DDA_INF, rng);
+  L += env * rs_residual_tr(D.origin, rs_domain_dir(D, rng_float2(rng)), DDA_INF, rng);
 #endif
   return L;
 }

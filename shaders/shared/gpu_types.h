@@ -34,7 +34,8 @@ struct GpuVolume {
 struct GpuLight {
   vec4 dirOrPos;   // sun: unit direction towards the sun; point: position
   vec4 emission;   // sun: irradiance (delta) or radiance (disk); point: intensity; env: radiance
-  vec4 params;     // x: type; y: sun's disk as 1 - cos(angular radius) (0 = delta)
+  vec4 params;     // x: type; y: sun's disk as 1 - cos(angular radius) (0 = delta);
+                   // z, w: ReSTIR's light choice probability and running sum (render/restir.cpp)
 };
 
 // Per frame (or per progressive batch) parameters.

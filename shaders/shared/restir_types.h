@@ -3,12 +3,13 @@
 // and GLSL (common.h), so the tests check the weights on the CPU with the code the GPU runs.
 //
 // A path y, in the coordinates the shift copies (DESIGN §4.2 step 4):
+//   (u, v)                  position inside the pixel (box filter), in pixels
 //   t1                      distance of the first vertex along the pixel's camera ray (world units)
 //   (w_i, t_i), i = 2..n    direction and distance of each further vertex (n <= RS_MAX_VERTICES)
 //   (light, u)              the light sample that ends the path: light index and two floats
 //                           (a direction for suns with a disk and the environment, unused for a
 //                           delta sun or a point light)
-// Its contribution f_D(y) in a domain D (camera ray, volume) is measured in dt1 dw2 dt2 ... dw_L,
+// Its contribution f_D(y) in a domain D (pixel of a frame, volume) is measured in du dv dt1 dw2 dt2 ... dw_L,
 // so copying the coordinates into another domain has Jacobian 1 and the light reconnection to a
 // direction or a point has none either. A future surface vertex is one more kind of vertex in
 // the same list (a flag in RsPathHead.info.z), with its own measure and Jacobian.
@@ -33,7 +34,8 @@ const uint RS_PASS_SPATIAL = 1u;
 // of vec4(direction, t), RestirParams.config.w (= max_bounces - 1) slots per pixel and set.
 struct RsPathHead {
   vec4 geo;   // x: t1; y, z: light sample; w: unused
-  uvec4 info; // x: vertex count n (0: no path); y: light index; z: vertex kinds (0: all media)
+  uvec4 info; // x: vertex count n (0: no path); y: light index; z: vertex kinds (0: all media);
+              // w: sub-pixel position (u, v) as two 16-bit unorms (restir/bridge.glsl)
 };
 
 // Per-frame parameters of the ReSTIR passes (beside GpuFrame, which holds the current camera).
@@ -45,7 +47,8 @@ struct RestirParams {
   uvec4 config;   // x: M candidates; y: k neighbours; z: MIS kind (RS_MIS_*); w: bounce stride
   vec4 configF;   // x: spatial radius (px); y: history cap c; z: reprojection depth (world); w: unused
   uvec4 frames;   // x: previous frame number; y: pixel count; z: history valid (0/1); w: light count
-  uvec4 unused;
+  uvec4 misc;     // x: 1 = every candidate vertex samples each light, 0 = one light by power;
+                  // y: 1 = the history's domain is the current one (still camera and volume)
 };
 
 // Push constants: which reservoir sets a pass reads and writes.

@@ -46,6 +46,9 @@ void addBenchCommand(CLI::App& app, Action& action) {
   cmd->add_option("--measure", args->options.frames, "measured frames")->check(CLI::Range(1, 1000));
   cmd->add_option("--ref-spp", args->options.refSpp, "samples per pixel of the cached reference")->check(CLI::Range(16, 1 << 24));
   cmd->add_option("--pt-spp", args->options.ptSpp, "path tracer spp per frame (its curve)");
+  cmd->add_option("--only", args->options.only, "run only the ReSTIR variants whose name contains one of these strings");
+  cmd->add_option("--camera", args->options.cameras, "camera runs: static, moving (default both)")
+      ->check(CLI::IsMember({"static", "moving"}));
   cmd->add_option("--orbit", args->options.orbitDegPerFrame, "moving camera: degrees of orbit per frame");
   cmd->add_option("--device", args->device, "Vulkan device to use (substring of its name)");
   addSettingOptions(*cmd, args->overrides);

@@ -227,6 +227,7 @@ void writeCoarse(BakedVolume& vol, uint32_t slot, const Window& w, float fractio
   // of the separable weights (1/4, 1/2, 1/4) (integrate the hat functions over the cell).
   const float hat[3] = {0.25f, 0.5f, 0.25f};
   float* m1 = &vol.coarse1Mean[size_t(slot) * 64];
+  float* r1 = &vol.coarse1Residual[size_t(slot) * 64];
   for (int z = 0; z < 4; ++z)
     for (int y = 0; y < 4; ++y)
       for (int x = 0; x < 4; ++x) {
@@ -235,6 +236,14 @@ void writeCoarse(BakedVolume& vol, uint32_t slot, const Window& w, float fractio
           for (int j = 0; j < 3; ++j)
             for (int i = 0; i < 3; ++i) sum += hat[k] * hat[j] * hat[i] * w[windowIndex(2 * x + i + 1, 2 * y + j + 1, 2 * z + k + 1)];
         m1[(z * 4 + y) * 4 + x] = float(sum);
+        double dev = 0.0;
+        for (int k = 0; k < 3; ++k)
+          for (int j = 0; j < 3; ++j)
+            for (int i = 0; i < 3; ++i) {
+              const double t = w[windowIndex(2 * x + i + 1, 2 * y + j + 1, 2 * z + k + 1)];
+              dev = std::max(dev, std::abs(t - sum) + std::abs(t) * 0x1p-10);
+            }
+        r1[(z * 4 + y) * 4 + x] = float(dev);
       }
   float* c2 = &vol.coarse2[size_t(slot) * 8];
   for (int z = 0; z < 2; ++z)
@@ -329,6 +338,7 @@ void fillBricks(BakedVolume& vol, const openvdb::FloatGrid& grid, const BrickBox
   vol.coarse1.assign(size_t(vol.slotCount) * 64, 0.0f);
   vol.coarse2.assign(size_t(vol.slotCount) * 8, 0.0f);
   vol.coarse1Mean.assign(size_t(vol.slotCount) * 64, 0.0f);
+  vol.coarse1Residual.assign(size_t(vol.slotCount) * 64, 0.0f);
   std::vector<float> brickMajorant(box.count(), 0.0f);
   for (const auto& [b, s] : slots) vol.indirection[b] = s;
 

@@ -89,6 +89,11 @@ struct BakedVolume {
   // of the trilinear field over each coarse1 cell, i.e. weights (1/4, 1/2, 1/4) per axis over
   // voxels 2c + {0, 1, 2}. coarse1Mean[slot*64 + (z*4+y)*4+x], like coarse1.
   std::vector<float> coarse1Mean;
+  // Residual majorant of that mean (ReSTIR's final shading: residual ratio tracking against the
+  // mean field): coarse1Residual[slot*64 + ...] >= |d(p) - coarse1Mean| for every p in the cell,
+  // the largest deviation of the cell's 3³ texels (a trilinear field's extremes lie on them),
+  // widened by 2^-10 of each texel to cover float16 storage and interpolation rounding.
+  std::vector<float> coarse1Residual;
 
   // Index -> world affine map of the grid (column vectors: world = indexToWorld * (i,j,k,1)).
   glm::mat4 indexToWorld{1.0f};

@@ -178,6 +178,12 @@ BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Sce
     v = base, v.mis = shared::RS_MIS_BIASED;
     add(v);
   }
+  if (!o.only.empty()) {
+    std::erase_if(variants, [&](const auto& v) {
+      return std::none_of(o.only.begin(), o.only.end(), [&](const std::string& k) { return v.first.find(k) != std::string::npos; });
+    });
+    if (variants.empty()) throw InputError("bench: no ReSTIR variant matches --only");
+  }
   // The grid of the first frame, held still: the bench measures the estimators, not the animation.
   const int first = scene.render.frameFirst;
   const int last = first + o.warmup + o.frames - 1;
@@ -188,6 +194,7 @@ BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Sce
 
   for (const bool moving : {false, true}) {
     const std::string cam = moving ? "moving" : "static";
+    if (std::find(o.cameras.begin(), o.cameras.end(), cam) == o.cameras.end()) continue;
     Scene s = withCamera(scene, moving, first, last, o.orbitDegPerFrame);
     std::map<int, Image> refs;
     for (int f = first + o.warmup; f <= last; ++f) {

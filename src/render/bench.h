@@ -21,6 +21,8 @@ struct BenchOptions {
   int refSpp = 2048;       // converged reference (GPU path tracer), >= 16x anything judged
   std::vector<int> ptSpp{1, 2, 4, 8, 16};
   std::vector<std::pair<std::string, RestirOptions>> variants;  // empty: a default list
+  std::vector<std::string> only;  // non-empty: ReSTIR variants whose name contains one of these
+  std::vector<std::string> cameras{"static", "moving"};
   float orbitDegPerFrame = 1.0f;  // the moving-camera run orbits the look-at point
   std::string outDir;             // table, CSV, SVG
 };

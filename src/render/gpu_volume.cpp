@@ -3,11 +3,14 @@
 #include "core/error.h"
 #include "core/log.h"
 
+#include <atomic>
 #include <algorithm>
 
 namespace plume {
 
 GpuVolumeResources::GpuVolumeResources(gpu::Context& ctx, const BakedVolume& bake, float densityScale) {
+  static std::atomic<uint64_t> nextSerial{1};
+  serial_ = nextSerial++;
   using namespace shared;
   const bool empty = bake.empty();
   params_.worldToIndex = bake.worldToIndex;
@@ -53,17 +56,19 @@ GpuVolumeResources::GpuVolumeResources(gpu::Context& ctx, const BakedVolume& bak
   indirection_.upload(packed.data(), packed.size() * 4);
   majorants_ = gpu::Buffer(ctx, majorants.size() * 4, storage, "majorant hierarchy");
   majorants_.upload(majorants.data(), majorants.size() * 4);
-  // Per atlas slot 128 floats: the conservative coarse1 cells (64), then their trilinear means (64).
-  std::vector<float> coarse(bake.coarse1.size() * 2);
+  // Per atlas slot 192 floats: the conservative coarse1 cells (64), their trilinear means (64)
+  // and the means' residual majorants (64) (restir/coarse.glsl).
+  std::vector<float> coarse(bake.coarse1.size() * 3);
   for (size_t slot = 0; slot < bake.coarse1.size() / 64; ++slot) {
-    std::copy_n(&bake.coarse1[slot * 64], 64, &coarse[slot * 128]);
-    std::copy_n(&bake.coarse1Mean[slot * 64], 64, &coarse[slot * 128 + 64]);
+    std::copy_n(&bake.coarse1[slot * 64], 64, &coarse[slot * 192]);
+    std::copy_n(&bake.coarse1Mean[slot * 64], 64, &coarse[slot * 192 + 64]);
+    std::copy_n(&bake.coarse1Residual[slot * 64], 64, &coarse[slot * 192 + 128]);
   }
   coarse_ = gpu::Buffer(ctx, coarse.size() * 4, storage, "coarse mip");
   coarse_.upload(coarse.data(), coarse.size() * 4);
   counters_ = gpu::Buffer(ctx, 16, storage, "tracking counters");
   resetCounters();
-  bytes_ = sizeof(params_) + atlasBytes + bake.indirection.size() * 4 + majorants.size() * 4 + bake.coarse1.size() * 8;
+  bytes_ = sizeof(params_) + atlasBytes + bake.indirection.size() * 4 + majorants.size() * 4 + bake.coarse1.size() * 12;
 }
 
 void GpuVolumeResources::bind(gpu::DescriptorSet& set) const {

@@ -26,6 +26,9 @@ class GpuVolumeResources {
                       uint32_t coarse) const;
   const shared::GpuVolume& params() const { return params_; }
   uint64_t deviceBytes() const { return bytes_; }
+  // Unique per constructed volume in this process (never reused), so a renderer can tell that
+  // the volume it rendered last frame is the one it is given now.
+  uint64_t serial() const { return serial_; }
 
   // Tracking loops truncated by the step cap since the last reset (no silent caps).
   uint32_t truncatedCount() const;
@@ -40,6 +43,7 @@ class GpuVolumeResources {
   gpu::Buffer counters_;
   gpu::Buffer coarse_;
   uint64_t bytes_ = 0;
+  uint64_t serial_ = 0;
 };
 
 }  // namespace plume

@@ -73,6 +73,8 @@ class Restir {
   bool hasHistory_ = false;
   uint32_t prevKey_ = 0;  // random-stream key of the history's frame
   uint32_t prevSequence_ = 0;
+  uint64_t currentSerial_ = 0, previousSerial_ = 0;  // volumes given to setVolumes
+  uint64_t renderedSerial_ = 0;                      // the volume the history was rendered with
   glm::vec4 prevCam_[4]{};
   glm::vec3 centre_{0.0f};  // world centre of the volume's bounds (reprojection depth)
   PassTimes passTimes_;
