@@ -23,6 +23,7 @@ layout(std430, binding = 13) buffer ReservoirBuffer { RsPacked rsReservoirs[]; }
 layout(std430, binding = 14) buffer PathBuffer { RsPathHead rsPaths[]; };
 // Vertices 2..n of each stored path: [(set * pixels + pixel) * stride + i - 2] = (w_i, t_i).
 layout(std430, binding = 15) buffer BounceBuffer { vec4 rsBounces[]; };
+// Progressive accumulation of final shading: [2 * pixel] = (mean rgb, n), [2 * pixel + 1] = (M2 rgb, 0).
 layout(std430, binding = 16) buffer OutputBuffer { vec4 rsOutput[]; };
 // rsCounters[0]: reservoirs whose non-finite weights were dropped on unpack (this frame).
 layout(std430, binding = 17) buffer RestirCounterBuffer { uint rsCounters[]; };

@@ -54,7 +54,7 @@ struct RestirParams {
 // Push constants: which reservoir sets a pass reads and writes.
 struct RsPush {
   uvec4 sets;  // x: canonical input set; y: neighbour input set; z: output set; w: pass kind
-  uvec4 misc;  // x: spatial round; y..w unused
+  uvec4 misc;  // x: spatial round; y: shading restarts the accumulation (1) or adds to it (0)
 };
 
 // --- Light sample encoding: a unit direction as (z, phi), exact enough for float storage ---

@@ -1,11 +1,12 @@
-// Viewer display pass: the renderer's linear RGB mean -> exposure -> the same filmic curve and
+// Viewer display pass: the renderer's linear RGB mean (read in place from its accumulation) -> exposure -> the same filmic curve and
 // sRGB encoding as the PNG previews (src/io/image.cpp toneMap) -> 8-bit pixels in the swapchain's
 // byte order, fitted into the window (aspect kept, nearest neighbour, black borders). The output
 // buffer is copied into the swapchain image with vkCmdCopyBufferToImage.
 #version 450
 layout(local_size_x = 16, local_size_y = 16) in;
 
-layout(std430, binding = 0) readonly buffer Source { float src[]; };  // 3 floats per pixel, row 0 at top
+// The renderer's accumulation: [2 * pixel] = (mean rgb, n), [2 * pixel + 1] = (M2 rgb, 0); row 0 at top.
+layout(std430, binding = 0) readonly buffer Source { vec4 src[]; };
 layout(std430, binding = 1) writeonly buffer Target { uint dst[]; };  // one packed pixel per texel
 
 layout(push_constant) uniform Push {
@@ -27,8 +28,7 @@ void main() {
   vec2 s = (vec2(p) + 0.5 - pc.fit.xy) * pc.fit.z;
   vec3 c = vec3(0.0);
   if (s.x >= 0.0 && s.y >= 0.0 && s.x < float(pc.size.x) && s.y < float(pc.size.y)) {
-    uint i = 3u * (uint(s.y) * pc.size.x + uint(s.x));
-    c = vec3(src[i], src[i + 1u], src[i + 2u]) * pc.fit.w;
+    c = src[2u * (uint(s.y) * pc.size.x + uint(s.x))].rgb * pc.fit.w;
   }
   uvec3 b = uvec3(round(255.0 * vec3(disp_toneMap(c.r), disp_toneMap(c.g), disp_toneMap(c.b))));
   if (pc.flags.x != 0u) b = b.bgr;

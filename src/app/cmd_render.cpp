@@ -74,25 +74,19 @@ int runRestirRender(const RenderArgs& a, const Scene& scene) {
     LoadedGrid grid = loadFloatGrid(medium.vdbPath(frame), medium.densityGrid);
     auto volume = std::make_unique<GpuVolumeResources>(ctx, bakeVolume(grid, bakeOptions), medium.densityScale);
     restir.setVolumes(*volume, prev ? *prev : *volume);
-    Image sum(scene.camera.width, scene.camera.height, true);
-    std::vector<double> s1(sum.rgb.size(), 0.0), s2(sum.rgb.size(), 0.0);
+    // render.spp ReSTIR iterations of the frame, averaged on the device; one read-back per frame.
     uint32_t dropped = 0;
     for (int i = 0; i < rs.spp; ++i) {
       if (i == 1) restir.setVolumes(*volume, *volume);
-      Image im = restir.renderFrame(frame, 0, uint32_t(i));
+      restir.render(frame, 0, uint32_t(i), i > 0);
       dropped += restir.lastDroppedCount();
-      for (size_t k = 0; k < im.rgb.size(); ++k) s1[k] += im.rgb[k], s2[k] += double(im.rgb[k]) * im.rgb[k];
-    }
-    const double n = rs.spp;
-    for (size_t k = 0; k < s1.size(); ++k) {
-      sum.rgb[k] = float(s1[k] / n);
-      sum.var[k] = n > 1 ? float(std::max(0.0, s2[k] / n - (s1[k] / n) * (s1[k] / n)) / (n - 1)) : 0.0f;
     }
     prev = std::move(volume);
     if (warmOnly) {
       if (!a.quiet) logInfo(strf("frame %d: pre-roll (not written)", frame));
       continue;
     }
+    Image sum = restir.readImage();
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     sum.meta["version"] = PLUME_VERSION;
     sum.meta["mode"] = rs.mode;

@@ -86,4 +86,21 @@ shared::GpuFrame gpuFrame(const Scene& scene, int frame, uint32_t seed, uint32_t
   return f;
 }
 
+Image readAccumulation(const gpu::Buffer& accum, int width, int height) {
+  const size_t pixels = size_t(width) * height;
+  std::vector<glm::vec4> data(2 * pixels);
+  accum.download(data.data(), data.size() * sizeof(glm::vec4));
+  Image image(width, height, true);
+  for (size_t i = 0; i < pixels; ++i) {
+    const glm::vec4 mean = data[2 * i];
+    const glm::vec3 m2 = glm::vec3(data[2 * i + 1]);
+    const float n = mean.w;
+    const glm::vec3 varMean = n > 1 ? glm::max(glm::vec3(0.0f), m2 / (n * (n - 1.0f))) : glm::vec3(0.0f);
+    const int x = int(i % size_t(width)), y = int(i / size_t(width));
+    image.setPixel(x, y, glm::vec3(mean));
+    image.setVariance(x, y, varMean);
+  }
+  return image;
+}
+
 }  // namespace plume

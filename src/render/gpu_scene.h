@@ -3,6 +3,8 @@
 // path tracer and ReSTIR so that both render the same scene.
 #pragma once
 
+#include "gpu/resources.h"
+#include "io/image.h"
 #include "scene/scene.h"
 #include "shaders/shared/gpu_types.h"
 
@@ -26,5 +28,9 @@ void gpuCameraVectors(const Camera& cam, int frame, glm::vec4 out[4]);
 // GpuFrame of `frame`: camera, medium, image size, bounces and light count from the scene;
 // the random-stream seed and frame key, and the samples per dispatch, from the caller.
 shared::GpuFrame gpuFrame(const Scene& scene, int frame, uint32_t seed, uint32_t frameKey, uint32_t sppPerDispatch);
+
+// A progressive accumulation buffer (per pixel: vec4(mean rgb, n), vec4(M2 rgb, 0), Welford's
+// update on the GPU) read back as the mean and the variance of the mean.
+Image readAccumulation(const gpu::Buffer& accum, int width, int height);
 
 }  // namespace plume

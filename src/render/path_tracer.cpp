@@ -104,22 +104,6 @@ void PathTracer::addSamples(int spp) {
   samples_ += spp;
 }
 
-Image PathTracer::readImage() const {
-  const Camera& cam = scene_.camera;
-  const size_t pixels = size_t(cam.width) * cam.height;
-  std::vector<glm::vec4> data(2 * pixels);
-  accum_.download(data.data(), data.size() * sizeof(glm::vec4));
-  Image image(cam.width, cam.height, true);
-  for (size_t i = 0; i < pixels; ++i) {
-    const glm::vec4 mean = data[2 * i];
-    const glm::vec3 m2 = glm::vec3(data[2 * i + 1]);
-    const float n = mean.w;
-    const glm::vec3 varMean = n > 1 ? glm::max(glm::vec3(0.0f), m2 / (n * (n - 1.0f))) : glm::vec3(0.0f);
-    const int x = int(i % size_t(cam.width)), y = int(i / size_t(cam.width));
-    image.setPixel(x, y, glm::vec3(mean));
-    image.setVariance(x, y, varMean);
-  }
-  return image;
-}
+Image PathTracer::readImage() const { return readAccumulation(accum_, scene_.camera.width, scene_.camera.height); }
 
 }  // namespace plume

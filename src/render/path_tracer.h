@@ -42,6 +42,9 @@ class PathTracer {
   void addSamples(int spp);
   int samplesSoFar() const { return samples_; }
   Image readImage() const;  // mean + variance of the mean
+  // The accumulation on the device (render/gpu_scene.h readAccumulation's layout), for a display
+  // pass that reads it in place.
+  const gpu::Buffer& accumulation() const { return accum_; }
   const PassTimes& lastPassTimes() const { return passTimes_; }
 
  private:

@@ -111,7 +111,7 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   reservoirs_ = gpu::Buffer(ctx, kSets * pixels * sizeof(shared::RsPacked), storage, "reservoirs");
   paths_ = gpu::Buffer(ctx, kSets * pixels * sizeof(shared::RsPathHead), storage, "reservoir paths");
   bounces_ = gpu::Buffer(ctx, kSets * pixels * stride * sizeof(glm::vec4), storage, "reservoir path vertices");
-  output_ = gpu::Buffer(ctx, pixels * sizeof(glm::vec4), storage, "restir output");
+  output_ = gpu::Buffer(ctx, 2 * pixels * sizeof(glm::vec4), storage, "restir accumulation");
   counters_ = gpu::Buffer(ctx, 16, storage, "restir counters");
   reservoirs_.fillZero();
   paths_.fillZero();
@@ -176,6 +176,13 @@ void Restir::fillFrame(int frame, uint32_t sequence, uint32_t key) {
 }
 
 Image Restir::renderFrame(int frame, uint32_t sequence, uint32_t iteration) {
+  render(frame, sequence, iteration, false);
+  return readImage();
+}
+
+Image Restir::readImage() const { return readAccumulation(output_, scene_.camera.width, scene_.camera.height); }
+
+void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accumulate) {
   const uint32_t key = uint32_t(frame) * 1024u + iteration;
   fillFrame(frame, sequence, key);
   const bool temporal = params_.frames.z != 0u;
@@ -211,6 +218,7 @@ Image Restir::renderFrame(int frame, uint32_t sequence, uint32_t iteration) {
       cur = out;
     }
     push.sets = glm::uvec4(cur, cur, cur, 0u);
+    push.misc = glm::uvec4(0u, accumulate ? 0u : 1u, 0u, 0u);
     shade_->record(cmd, items, &push, &timer_);
     labels.push_back("shade");
     finalSet = cur;
@@ -224,14 +232,6 @@ Image Restir::renderFrame(int frame, uint32_t sequence, uint32_t iteration) {
   uint32_t counters[4];
   counters_.download(counters, sizeof counters);
   dropped_ = counters[0];
-
-  const Camera& cam = scene_.camera;
-  const size_t pixels = size_t(cam.width) * cam.height;
-  std::vector<glm::vec4> data(pixels);
-  output_.download(data.data(), data.size() * sizeof(glm::vec4));
-  Image image(cam.width, cam.height, false);
-  for (size_t i = 0; i < pixels; ++i) image.setPixel(int(i % size_t(cam.width)), int(i / size_t(cam.width)), glm::vec3(data[i]));
-  return image;
 }
 
 double Restir::lastFrameGpuMs() const {

@@ -49,9 +49,15 @@ class Restir {
   void resetHistory();
   // Renders `frame` (camera pose of that frame) with seed render.seed + 0x9E3779B9 * sequence:
   // independent sequences for the same frame are decorrelated. Returns the frame's image (one
-  // ReSTIR sample per pixel, no variance channel). `iteration` > 0 renders the same frame again
+  // ReSTIR sample per pixel; its variance channel is 0). `iteration` > 0 renders the same frame again
   // with fresh random numbers (the random streams are keyed by frame * 1024 + iteration).
   Image renderFrame(int frame, uint32_t sequence = 0, uint32_t iteration = 0);
+  // The same without the read-back: the frame's final shading restarts the accumulation on the
+  // device (accumulate = false) or is averaged into it (true); readImage gives the mean and the
+  // variance of the mean of the accumulated frames, accumulation() the device buffer itself.
+  void render(int frame, uint32_t sequence, uint32_t iteration, bool accumulate);
+  Image readImage() const;
+  const gpu::Buffer& accumulation() const { return output_; }
   const PassTimes& lastPassTimes() const { return passTimes_; }
   double lastFrameGpuMs() const;
   // Reservoir unpacks whose non-finite weights were dropped in the last frame (DESIGN §4.2.3).

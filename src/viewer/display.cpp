@@ -28,20 +28,16 @@ DisplayPass::DisplayPass(gpu::Context& ctx, gpu::ShaderCompiler& compiler) : ctx
                                              uint32_t(sizeof(DisplayPush)), "display", glm::uvec3(16, 16, 1));
 }
 
-void DisplayPass::setSource(const Image& image) {
-  const VkDeviceSize bytes = image.rgb.size() * sizeof(float);
-  if (!src_.valid() || src_.size() != bytes) {
-    src_ = gpu::Buffer(ctx_, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "display source");
-    pass_->set.bind(0, src_);
-  }
-  src_.upload(image.rgb.data(), bytes);
-  srcWidth_ = image.width;
-  srcHeight_ = image.height;
+void DisplayPass::setSource(const gpu::Buffer& accumulation, int width, int height) {
+  pass_->set.bind(0, accumulation);  // every time: a rebuilt renderer may reuse a freed handle
+  src_ = accumulation.handle();
+  srcWidth_ = width;
+  srcHeight_ = height;
 }
 
 void DisplayPass::record(VkCommandBuffer cmd, VkImage target, VkExtent2D extent, bool bgra, float exposureStops,
                          gpu::GpuTimer* timer) {
-  PLUME_CHECK_MSG(src_.valid(), "DisplayPass::record before setSource");
+  PLUME_CHECK_MSG(src_ != VK_NULL_HANDLE, "DisplayPass::record before setSource");
   const VkDeviceSize bytes = VkDeviceSize(extent.width) * extent.height * 4;
   if (!dst_.valid() || dst_.size() != bytes) {
     dst_ = gpu::Buffer(ctx_, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT, "display target");

@@ -18,7 +18,9 @@ class DisplayPass {
  public:
   DisplayPass(gpu::Context& ctx, gpu::ShaderCompiler& compiler);
 
-  void setSource(const Image& image);  // uploads the mean RGB
+  // Reads the renderer's accumulation buffer in place (render/gpu_scene.h readAccumulation's
+  // layout: the mean RGB in every other vec4). The buffer must outlive the recorded frames.
+  void setSource(const gpu::Buffer& accumulation, int width, int height);
   // Records the tone map and the copy; leaves `target` in TRANSFER_DST_OPTIMAL (its previous
   // contents are discarded).
   void record(VkCommandBuffer cmd, VkImage target, VkExtent2D extent, bool bgra, float exposureStops,
@@ -27,7 +29,8 @@ class DisplayPass {
  private:
   gpu::Context& ctx_;
   std::unique_ptr<gpu::ComputePass> pass_;
-  gpu::Buffer src_, dst_;
+  VkBuffer src_ = VK_NULL_HANDLE;  // the bound source (owned by the renderer)
+  gpu::Buffer dst_;
   int srcWidth_ = 0, srcHeight_ = 0;
 };
 

@@ -18,6 +18,7 @@ class PathTracerView final : public ViewRenderer {
   void addSamples(int spp) override { tracer_.addSamples(spp); }
   int samplesSoFar() const override { return tracer_.samplesSoFar(); }
   Image readImage() const override { return tracer_.readImage(); }
+  const gpu::Buffer& accumulation() const override { return tracer_.accumulation(); }
   PassTimes lastPassTimes() const override { return tracer_.lastPassTimes(); }
 
  private:
@@ -27,43 +28,34 @@ class PathTracerView final : public ViewRenderer {
 // Volumetric ReSTIR (DESIGN §4.2). Temporal reuse follows the camera while the animation frame
 // stays; a new animation frame (or an edit that breaks continuity) starts a fresh history, as
 // the viewer keeps only the current frame's volume on the device. Progressive accumulation
-// averages successive ReSTIR frames of a still view (they are correlated through reuse; the
-// average converges all the same).
+// averages successive ReSTIR frames of a still view on the device (they are correlated through
+// reuse; the average converges all the same).
 class RestirView final : public ViewRenderer {
  public:
   RestirView(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene)
-      : scene_(scene), restir_(ctx, compiler, scene, restirOptionsOf(scene.render)) {}
+      : restir_(ctx, compiler, scene, restirOptionsOf(scene.render)) {}
   std::string name() const override { return "ReSTIR [" + restir_.options().name() + "]"; }
   void setVolume(const GpuVolumeResources& volume) override { restir_.setVolumes(volume, volume); }
   void beginFrame(int frame, bool continuous) override {
     if (!continuous || frame != frame_) restir_.resetHistory();
     frame_ = frame;
-    sum_.clear();
     samples_ = 0;
   }
   void addSamples(int spp) override {
-    for (int i = 0; i < spp && iteration_ < kMaxIterations; ++i) {
-      Image im = restir_.renderFrame(frame_, 0, iteration_++);
-      if (sum_.empty()) sum_.assign(im.rgb.size(), 0.0);
-      for (size_t k = 0; k < im.rgb.size(); ++k) sum_[k] += im.rgb[k];
-      ++samples_;
+    for (int i = 0; i < spp && iteration_ < kMaxIterations; ++i, ++samples_) {
+      restir_.render(frame_, 0, iteration_++, samples_ > 0);
     }
   }
   int samplesSoFar() const override { return samples_; }
-  Image readImage() const override {
-    Image out(scene_.camera.width, scene_.camera.height);
-    for (size_t k = 0; k < sum_.size() && samples_ > 0; ++k) out.rgb[k] = float(sum_[k] / samples_);
-    return out;
-  }
+  Image readImage() const override { return restir_.readImage(); }
+  const gpu::Buffer& accumulation() const override { return restir_.accumulation(); }
   PassTimes lastPassTimes() const override { return restir_.lastPassTimes(); }
 
  private:
   static constexpr uint32_t kMaxIterations = 1024;  // random streams are keyed frame * 1024 + iteration
-  const Scene& scene_;
   Restir restir_;
   int frame_ = 0;
   uint32_t iteration_ = 0;
-  std::vector<double> sum_;
   int samples_ = 0;
 };
 

@@ -30,6 +30,9 @@ class ViewRenderer {
   virtual void addSamples(int spp) = 0;
   virtual int samplesSoFar() const = 0;
   virtual Image readImage() const = 0;
+  // The accumulation on the device (render/gpu_scene.h readAccumulation's layout), which the
+  // display pass tone-maps in place: no read-back per frame.
+  virtual const gpu::Buffer& accumulation() const = 0;
   virtual PassTimes lastPassTimes() const = 0;
 };
 

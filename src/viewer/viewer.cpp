@@ -247,7 +247,7 @@ void Viewer::renderAndPresent(bool capture) {
   if (renderer_->samplesSoFar() < s_.maxSamples) {
     renderer_->addSamples(std::min(s_.sppPerFrame, s_.maxSamples - renderer_->samplesSoFar()));
     rendererTimes_ = renderer_->lastPassTimes();
-    display_->setSource(renderer_->readImage());
+    display_->setSource(renderer_->accumulation(), s_.scene.camera.width, s_.scene.camera.height);
     haveImage_ = true;
   }
   stats_.samples = renderer_->samplesSoFar();
