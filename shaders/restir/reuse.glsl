@@ -10,24 +10,35 @@
 
 const uint RS_MAX_INPUTS = RS_MAX_NEIGHBOURS + 1u;
 
+// The inputs of this invocation's reuse step, kept small: a domain is rebuilt from its pixel
+// when needed (a few multiply-adds) rather than stored per input, since private arrays are
+// memory on some devices (lavapipe). Input 0 is the canonical one, in the current frame.
 struct RsInputs {
   uint count;                       // 1 + neighbours
-  uint set[RS_MAX_INPUTS];          // reservoir set of each input
+  uint set;                         // reservoir set of every input but the history
+  uint historySet;                  // reservoir set of input 1 when `history`
+  bool history;                     // input 1 is the previous frame's (its domain, its volume)
+  bool sameDomain;                  // ... and that domain is input 0's (still camera and volume)
   uint pixel[RS_MAX_INPUTS];        // pixel index of each input
-  RsDomain domain[RS_MAX_INPUTS];   // its domain (the pixel's ray in its frame, that frame's volume)
   RsReservoir res[RS_MAX_INPUTS];   // its reservoir (confidence already capped)
-  bool sameDomain;                  // inputs 0 and 1 share one domain (still camera and volume)
 };
+
+// One shader-private variable, not a by-value argument (a copy of the whole array per call is
+// what a by-value struct compiles to).
+RsInputs in_;
+
+uint rs_input_set(uint j) { return (j == 1u && in_.history) ? in_.historySet : in_.set; }
+
+RsDomain rs_input_domain(uint j) {
+  uvec2 p = uvec2(in_.pixel[j] % frame.image.x, in_.pixel[j] / frame.image.x);
+  return (j == 1u && in_.history) ? rs_previous_domain(p) : rs_current_domain(p);
+}
 
 // p̂ of input s's path in input j's domain (the stored value when j == s or when both share
 // the domain: the same deterministic function of the same arguments).
-// The inputs of this invocation's reuse step: one shader-private variable, not a by-value
-// argument (a copy of the whole array per call is what a by-value struct compiles to).
-RsInputs in_;
-
 float rs_target_in(uint s, uint j) {
   if (j == s || (in_.sameDomain && s <= 1u && j <= 1u)) return in_.res[s].p_hat;
-  return rs_target(in_.domain[j], in_.set[s], in_.pixel[s]);
+  return rs_target(rs_input_domain(j), rs_input_set(s), in_.pixel[s]);
 }
 
 // Resamples the inputs into input 0's domain; writes the reservoir and the selected path to
@@ -40,7 +51,7 @@ void rs_reuse(uint misKind, uint outSet, uint outPixel, inout RngState rng) {
   uint selected = RS_MAX_INPUTS;
   for (uint s = 0u; s < in_.count; ++s) {
     RsReservoir rs_ = in_.res[s];
-    bool hasSample = rs_.W > 0.0f && rsPaths[rs_slot(in_.set[s], in_.pixel[s])].info.x > 0u;
+    bool hasSample = rs_.W > 0.0f && rsPaths[rs_slot(rs_input_set(s), in_.pixel[s])].info.x > 0u;
     float phC = 0.0f;
     float m = 0.0f;
     if (hasSample) {
@@ -66,7 +77,7 @@ void rs_reuse(uint misKind, uint outSet, uint outPixel, inout RngState rng) {
   }
   rs_finalize(out_);
   if (selected < RS_MAX_INPUTS && out_.W > 0.0f) {
-    rs_copy_path(in_.set[selected], in_.pixel[selected], outSet, outPixel);
+    rs_copy_path(rs_input_set(selected), in_.pixel[selected], outSet, outPixel);
   } else {
     out_.w_sum = 0.0f;
     out_.p_hat = 0.0f;
@@ -93,6 +104,47 @@ bool rs_reproject(uvec2 pixel, out uvec2 prevPixel) {
   if (!(f.x >= 0.0f && f.y >= 0.0f && f.x < float(frame.image.x) && f.y < float(frame.image.y))) return false;
   prevPixel = uvec2(f);
   return true;
+}
+
+// One reuse step for `pixel` (index `index`): temporal (the canonical reservoir of set inSet and
+// the history of set histSet at the reprojected pixel, its confidence capped) or spatial
+// `spatialRound` (k neighbours of set inSet in the disk, drawn from the pixel and the round only, never
+// from the samples). Output: set outSet.
+void rs_reuse_pixel(uvec2 pixel, uint index, bool temporal, uint spatialRound, uint inSet, uint histSet, uint outSet) {
+  in_.count = 1u;
+  in_.set = inSet;
+  in_.historySet = histSet;
+  in_.history = false;
+  in_.sameDomain = false;
+  in_.pixel[0] = index;
+  in_.res[0] = rs_load(inSet, index);
+  uint stream = temporal ? RNG_STREAM_TEMPORAL : RNG_STREAM_SPATIAL + (spatialRound << 8u);
+  RngState rng = rng_init(pixel, frame.seeds.y, stream, frame.seeds.x);
+  if (temporal) {
+    uvec2 q;
+    if (rsp.frames.z != 0u && rs_reproject(pixel, q)) {
+      uint qi = q.y * frame.image.x + q.x;
+      in_.history = true;
+      in_.pixel[1] = qi;
+      in_.sameDomain = rsp.misc.y != 0u && qi == index;
+      in_.res[1] = rs_load(histSet, qi);
+      rs_cap_confidence(in_.res[1], rsp.configF.y * in_.res[0].M);
+      in_.count = 2u;
+    }
+  } else {
+    for (uint i = 0u; i < rsp.config.y; ++i) {
+      vec2 u = rng_float2(rng);  // neighbour offsets: uniform in the disk, independent of samples
+      float radius = rsp.configF.x * sqrt(u.x);
+      ivec2 q = ivec2(pixel) + ivec2(round(radius * vec2(cos(2.0f * PLUME_PI * u.y), sin(2.0f * PLUME_PI * u.y))));
+      if (any(lessThan(q, ivec2(0))) || q.x >= int(frame.image.x) || q.y >= int(frame.image.y)) continue;
+      if (q == ivec2(pixel)) continue;
+      uint qi = uint(q.y) * frame.image.x + uint(q.x);
+      uint k = in_.count++;
+      in_.pixel[k] = qi;
+      in_.res[k] = rs_load(inSet, qi);
+    }
+  }
+  rs_reuse(rsp.config.z, outSet, index, rng);
 }
 
 #endif

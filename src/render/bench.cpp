@@ -233,8 +233,8 @@ BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Sce
           im = m.restir->renderFrame(f);
           times = m.restir->lastPassTimes();
         }
-        for (const auto& [n, t] : times) ms += t, m.passMs[n].push_back(t);
         if (f < first + o.warmup) continue;
+        for (const auto& [n, t] : times) ms += t, m.passMs[n].push_back(t);
         const Image& ref = moving ? refs.at(f) : refs.begin()->second;
         m.ms.push_back(ms);
         m.err.push_back(relMse(im, ref));
