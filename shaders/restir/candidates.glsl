@@ -1,11 +1,13 @@
-// Candidate paths (DESIGN §4.2 step 1). M random walks per pixel: each vertex's distance comes
-// from coarse tracking in the conservative field (pdf sigma_c exp(-tau_c), closed form), each further direction from HG
-// sampling, and every vertex ends one candidate with a light sample. The candidate ending at
-// vertex j of walk m is the path (t1, w2, t2, ..., w_j, t_j, light) with source pdf
+// Candidate paths (DESIGN §4.2 step 1). M random walks per pixel, each from its own uniform
+// position (u, v) in the pixel: each vertex's distance comes from coarse tracking in the mean
+// field (pdf sigma_c exp(-tau_c), closed form; restir/coarse.glsl), each further direction from HG
+// sampling, and every vertex ends one candidate per light (few lights) or one with a light
+// chosen by power (many). The candidate ending at vertex j of walk m with light l is the path
+// (u, v, t1, w2, t2, ..., w_j, t_j, l, light sample) with source pdf
 //   p(y) = prod_i sigma_c(x_i) exp(-tau_i) * prod_{i>=2} phase_i * prod q (Russian roulette)
 //          * p_light,
-// and only "vertex j of some walk" can produce a path of j vertices, so the M walks give it the
-// MIS weight 1/M (GRIS allows candidates of one walk to be dependent: only marginals matter).
+// and only "vertex j of some walk, light l" can produce it, so the M walks give it the MIS
+// weight 1/M (GRIS allows candidates of one walk to be dependent: only marginals matter).
 // The reservoir's confidence is M. Requires restir/bridge.glsl.
 #ifndef PLUME_RESTIR_CANDIDATES_GLSL
 #define PLUME_RESTIR_CANDIDATES_GLSL
@@ -39,9 +41,8 @@ void rs_generate_candidates(uvec2 pixel, uint pixelIndex, uint outSet) {
       float t;
       float sigmaC;
       float tau;
-      float tauMean;
-      if (!rs_coarse_sample(x, w, DDA_INF, rng_float(rng), t, sigmaC, tau, tauMean)) break;
-      float trTarget = exp(-min(tauMean, RS_MAX_TAU));  // the target's transmittance (mean field)
+      if (!rs_coarse_sample(x, w, DDA_INF, rng_float(rng), t, sigmaC, tau)) break;
+      float trTarget = exp(-min(tau, RS_MAX_TAU));  // the target's transmittance (same field)
       x += t * w;
       float sigma = rsv_sigma_t(0u, x);
       if (!(sigma > 0.0f)) break;  // f = 0 for this path and every extension of it

@@ -1,11 +1,13 @@
 // Volume lookups for ReSTIR's target function and candidates, for the current (v = 0) or the
 // previous frame's (v = 1) bake: fine trilinear density (the same arithmetic as
-// volume/volume.glsl's vol_density) and two piecewise-constant coarse fields on 2³-voxel cells:
-// the conservative one (bake.coarse1, positive wherever the fine density is, DESIGN §3) that
-// candidate distances are drawn from, and the cell means of the trilinear field
-// (bake.coarse1Mean) that give the target's cheap deterministic transmittance. Keeping them apart
-// puts the dilation's extra optical depth into the candidates' resampling weights, which reuse
-// averages, instead of into f / p̂ at final shading, which no reuse can reduce.
+// volume/volume.glsl's vol_density) and, on 2³-voxel cells, the piecewise-constant field of the
+// cell means of the trilinear density (bake.coarse1Mean) and a bound on the fine density's
+// deviation from it (bake.coarse1Residual). The mean field is what candidates track, what the
+// target's transmittance integrates and the control of final shading's residual ratio tracking.
+// It is positive wherever the fine density is (a cell's mean weighs all its texels positively),
+// so candidates cover the target's support without the dilated field of DESIGN §3: tracking the
+// dilated field made the weights p̂ / p grow like exp(tau_dilated - tau_mean) with depth, and
+// those rare huge weights, kept by temporal reuse, were most of the error (notes/restir.md).
 // Coarse tracking: in a piecewise-constant medium the majorant equals the density, so every
 // tentative collision is real and the free-flight pdf is sigma_c(t) exp(-tau_c(0, t)) in closed
 // form, with tau_c the exact optical depth of the coarse field, summed cell by cell with a DDA.
@@ -15,15 +17,12 @@
 
 #include "../shared/dda.h"
 
-// Cells of bake.coarse1: 2³ voxels, 4³ per brick. The buffer holds, per atlas slot, the 64
-// conservative (dilated) cell values, for sampling distances, the 64 trilinear means, for the
-// target's transmittance, and the 64 residual majorants of the means, for final shading
-// (render/gpu_volume.cpp).
+// Cells: 2³ voxels, 4³ per brick. The buffer holds, per atlas slot, the 64 cell means then their
+// 64 residual bounds (render/gpu_volume.cpp).
 const int RS_COARSE_PER_BRICK = 4;   // cells per brick edge
 const float RS_COARSE_CELL = 2.0f;   // voxels per cell edge
-const uint RS_COARSE_SAMPLING = 0u;  // which field: conservative, for sampling
-const uint RS_COARSE_MEAN = 1u;      // the trilinear mean, for approximate transmittance
-const uint RS_COARSE_RESIDUAL = 2u;  // bound on |fine - mean| in the cell (residual tracking)
+const uint RS_COARSE_MEAN = 0u;      // which field: the trilinear mean
+const uint RS_COARSE_RESIDUAL = 1u;  // bound on |fine - mean| in the cell (residual tracking)
 const float RS_MAX_TAU = 80.0f;      // exp(-80) > 0 in float: p̂ stays strictly positive
 
 float rsv_scale(uint v) { return v == 0u ? vol.boundsMin.w : prevVol.boundsMin.w; }
@@ -73,7 +72,7 @@ float rsv_sigma_t(uint v, vec3 xWorld) {
 }
 
 // Value of a cell of the coarse DDA grid (cell 0 = first voxel of brick brickOrigin) in one of
-// the two fields (RS_COARSE_SAMPLING or RS_COARSE_MEAN).
+// the two fields (RS_COARSE_MEAN or RS_COARSE_RESIDUAL).
 float rsv_coarse_cell(uint v, ivec3 cell, uint field) {
   ivec3 origin = v == 0u ? vol.brickOrigin.xyz : prevVol.brickOrigin.xyz;
   uint slot = rsv_packed_slot(v, origin + cell / RS_COARSE_PER_BRICK);
@@ -81,7 +80,7 @@ float rsv_coarse_cell(uint v, ivec3 cell, uint field) {
   ivec3 slots = v == 0u ? vol.atlasSlots.xyz : prevVol.atlasSlots.xyz;
   uint index = (slot & 1023u) + uint(slots.x) * (((slot >> 10u) & 1023u) + uint(slots.y) * (slot >> 20u));
   ivec3 c = cell % RS_COARSE_PER_BRICK;
-  uint i = index * 192u + field * 64u + uint((c.z * RS_COARSE_PER_BRICK + c.y) * RS_COARSE_PER_BRICK + c.x);
+  uint i = index * 128u + field * 64u + uint((c.z * RS_COARSE_PER_BRICK + c.y) * RS_COARSE_PER_BRICK + c.x);
   return v == 0u ? volCoarse[i] : prevCoarse[i];
 }
 
@@ -114,16 +113,14 @@ float rs_coarse_tr(uint v, vec3 xWorld, vec3 wWorld, float tMax) {
   return exp(-min(rs_coarse_tau(v, xWorld, wWorld, tMax), RS_MAX_TAU));
 }
 
-// Coarse tracking on the current volume: the first collision in (0, tMax) with pdf
-// sigmaC * exp(-tau); false (probability exp(-tau_c(0, tMax))) when the ray leaves first. The
-// same march sums the mean field's optical depth up to the collision (tauMean, as rs_coarse_tau
-// over (0, t)), the target's transmittance of the segment, so candidates march each segment once.
-bool rs_coarse_sample(vec3 xWorld, vec3 wWorld, float tMax, float u, out float t, out float sigmaC,
-                      out float tau, out float tauMean) {
+// Coarse tracking on the current volume's mean field: the first collision in (0, tMax) with pdf
+// sigmaC * exp(-tau); false (probability exp(-tau_c(0, tMax))) when the ray leaves first. tau,
+// the optical depth to the collision, is also the target's transmittance of the segment, so a
+// candidate marches each segment once. (tau <= -log(2^-24) ~ 16.6: the pdf never underflows.)
+bool rs_coarse_sample(vec3 xWorld, vec3 wWorld, float tMax, float u, out float t, out float sigmaC, out float tau) {
   t = tMax;
   sigmaC = 0.0f;
   tau = -log(1.0f - u);
-  tauMean = 0.0f;
   vec3 o;
   vec3 d;
   rsv_ray_to_index(0u, xWorld, wWorld, o, d);
@@ -135,16 +132,13 @@ bool rs_coarse_sample(vec3 xWorld, vec3 wWorld, float tMax, float u, out float t
   float b;
   ivec3 cell;
   while (dda_next(s, a, b, cell)) {
-    float sigma = scale * rsv_coarse_cell(0u, cell, RS_COARSE_SAMPLING);
+    float sigma = scale * rsv_coarse_cell(0u, cell, RS_COARSE_MEAN);
     float dtau = sigma * (b - a);
-    float mean = scale * rsv_coarse_cell(0u, cell, RS_COARSE_MEAN);
     if (sigma > 0.0f && dtau >= left) {
       t = a + left / sigma;
       sigmaC = sigma;
-      tauMean += mean * (t - a);
       return true;
     }
-    tauMean += mean * (b - a);
     left -= dtau;
   }
   return false;

@@ -49,6 +49,7 @@ void addBenchCommand(CLI::App& app, Action& action) {
   cmd->add_option("--only", args->options.only, "run only the ReSTIR variants whose name contains one of these strings");
   cmd->add_option("--camera", args->options.cameras, "camera runs: static, moving (default both)")
       ->check(CLI::IsMember({"static", "moving"}));
+  cmd->add_flag("--save-images", args->options.saveImages, "also write each method's last measured frame and its reference (EXR)");
   cmd->add_option("--orbit", args->options.orbitDegPerFrame, "moving camera: degrees of orbit per frame");
   cmd->add_option("--device", args->device, "Vulkan device to use (substring of its name)");
   addSettingOptions(*cmd, args->overrides);

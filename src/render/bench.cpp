@@ -160,6 +160,8 @@ std::string svgPlot(const std::vector<BenchRow>& rows, const std::string& title)
 BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene, const BenchOptions& o) {
   BenchResult result;
   result.device = ctx.deviceName();
+  const std::string dir = o.outDir.empty() ? (fs::path(scene.dir) / "bench_out").string() : o.outDir;
+  fs::create_directories(dir);
   std::vector<std::pair<std::string, RestirOptions>> variants = o.variants;
   if (variants.empty()) {
     const RestirOptions base = restirOptionsOf(scene.render);
@@ -238,6 +240,12 @@ BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Sce
         const Image& ref = moving ? refs.at(f) : refs.begin()->second;
         m.ms.push_back(ms);
         m.err.push_back(relMse(im, ref));
+        if (o.saveImages && f == last) {
+          std::string file = cam + "_" + m.name + ".exr";
+          std::replace(file.begin(), file.end(), ' ', '_');
+          writeExr((fs::path(dir) / file).string(), im);
+          if (&m == &methods.front()) writeExr((fs::path(dir) / (cam + "_reference.exr")).string(), ref);
+        }
       }
     }
     std::vector<std::pair<double, double>> curve;
@@ -276,8 +284,6 @@ BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Sce
                 r.ptRelMseAtEqualTime, r.gain);
   }
   result.markdown = md;
-  const std::string dir = o.outDir.empty() ? (fs::path(scene.dir) / "bench_out").string() : o.outDir;
-  fs::create_directories(dir);
   const std::string stem = fs::path(scene.path).stem().string();
   result.mdPath = (fs::path(dir) / (stem + "_bench.md")).string();
   result.csvPath = (fs::path(dir) / (stem + "_bench.csv")).string();

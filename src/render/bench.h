@@ -25,6 +25,7 @@ struct BenchOptions {
   std::vector<std::string> cameras{"static", "moving"};
   float orbitDegPerFrame = 1.0f;  // the moving-camera run orbits the look-at point
   std::string outDir;             // table, CSV, SVG
+  bool saveImages = false;        // also each method's last measured frame (EXR) in outDir
 };
 
 struct BenchRow {

@@ -56,19 +56,18 @@ GpuVolumeResources::GpuVolumeResources(gpu::Context& ctx, const BakedVolume& bak
   indirection_.upload(packed.data(), packed.size() * 4);
   majorants_ = gpu::Buffer(ctx, majorants.size() * 4, storage, "majorant hierarchy");
   majorants_.upload(majorants.data(), majorants.size() * 4);
-  // Per atlas slot 192 floats: the conservative coarse1 cells (64), their trilinear means (64)
-  // and the means' residual majorants (64) (restir/coarse.glsl).
-  std::vector<float> coarse(bake.coarse1.size() * 3);
-  for (size_t slot = 0; slot < bake.coarse1.size() / 64; ++slot) {
-    std::copy_n(&bake.coarse1[slot * 64], 64, &coarse[slot * 192]);
-    std::copy_n(&bake.coarse1Mean[slot * 64], 64, &coarse[slot * 192 + 64]);
-    std::copy_n(&bake.coarse1Residual[slot * 64], 64, &coarse[slot * 192 + 128]);
+  // Per atlas slot 128 floats: the trilinear field's cell means (64) and their residual bounds
+  // (64) (restir/coarse.glsl).
+  std::vector<float> coarse(bake.coarse1Mean.size() * 2);
+  for (size_t slot = 0; slot < bake.coarse1Mean.size() / 64; ++slot) {
+    std::copy_n(&bake.coarse1Mean[slot * 64], 64, &coarse[slot * 128]);
+    std::copy_n(&bake.coarse1Residual[slot * 64], 64, &coarse[slot * 128 + 64]);
   }
   coarse_ = gpu::Buffer(ctx, coarse.size() * 4, storage, "coarse mip");
   coarse_.upload(coarse.data(), coarse.size() * 4);
   counters_ = gpu::Buffer(ctx, 16, storage, "tracking counters");
   resetCounters();
-  bytes_ = sizeof(params_) + atlasBytes + bake.indirection.size() * 4 + majorants.size() * 4 + bake.coarse1.size() * 12;
+  bytes_ = sizeof(params_) + atlasBytes + bake.indirection.size() * 4 + majorants.size() * 4 + coarse.size() * 4;
 }
 
 void GpuVolumeResources::bind(gpu::DescriptorSet& set) const {
