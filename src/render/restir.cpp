@@ -12,7 +12,8 @@ namespace plume {
 
 std::string RestirOptions::name() const {
   const char* kind = mis == shared::RS_MIS_GBH ? "gbh" : mis == shared::RS_MIS_BIASED ? "biased" : "pairwise";
-  return strf("restir %s M%d k%d R%d c%d", kind, candidates, neighbours, rounds, historyCap);
+  if (rounds == 0) return strf("restir %s M%d R0 c%d", kind, candidates, historyCap);
+  return strf("restir %s M%d k%d r%d R%d c%d", kind, candidates, neighbours, radius, rounds, historyCap);
 }
 
 RestirOptions restirOptionsOf(const RenderSettings& rs) {

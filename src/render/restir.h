@@ -30,7 +30,7 @@ struct RestirOptions {
   int rounds = 1;            // R (0: no spatial reuse)
   int historyCap = 20;       // c (0: no temporal reuse)
   uint32_t mis = shared::RS_MIS_PAIRWISE;
-  std::string name() const;  // e.g. "restir pairwise M4 k3 R1 c20"
+  std::string name() const;  // e.g. "restir pairwise M4 k3 r16 R1 c20" (r: radius in px)
 };
 // From the scene's render settings (mode restir-biased selects RS_MIS_BIASED).
 RestirOptions restirOptionsOf(const RenderSettings& rs);
