@@ -200,6 +200,10 @@ TEST_F(GpuRestir, MultipleScatteringWithoutReuseMatchesReference) {
   s.render.rrStartBounce = 1;
   auto grid = test::makeNoiseGrid(40, 1.0 / 20, 3);
   RunSpec spec;
+  // Multi-bounce weights are heavy-tailed: 256 runs underestimate a pixel's variance now and
+  // then (a z of -4.4 on one pixel with 256 runs, 2.7 worst with 2048 against the same
+  // reference); 1024 runs keep the variance estimate honest.
+  if (!std::getenv("PLUME_RESTIR_RUNS")) spec.runs = 1024;
   RestirRun run = runRestir(ctx(), compiler(), s, noReuse(), spec, [&](int) { return grid; });
   expectMatches(run, reference(s, grid, 512), "no_reuse_multi");
 }

@@ -13,7 +13,7 @@
 layout(std430, binding = 5) readonly buffer FrameBuffer { GpuFrame frame; };
 layout(std430, binding = 6) readonly buffer LightBuffer { GpuLight lights[]; };
 layout(std430, binding = 7) readonly buffer RestirParamBuffer { RestirParams rsp; };
-layout(std430, binding = 8) readonly buffer CoarseBuffer { float volCoarse[]; };  // cell means, residuals: 128 per slot
+layout(std430, binding = 8) readonly buffer CoarseBuffer { float volCoarse[]; };  // voxel means, residuals: 1024 per slot
 layout(std430, binding = 9) readonly buffer PrevVolumeBuffer { GpuVolume prevVol; };
 layout(binding = 10) uniform sampler3D prevAtlas;
 layout(std430, binding = 11) readonly buffer PrevIndirectionBuffer { uint prevIndirection[]; };

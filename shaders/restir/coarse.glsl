@@ -1,13 +1,15 @@
 // Volume lookups for ReSTIR's target function and candidates, for the current (v = 0) or the
 // previous frame's (v = 1) bake: fine trilinear density (the same arithmetic as
-// volume/volume.glsl's vol_density) and, on 2³-voxel cells, the piecewise-constant field of the
-// cell means of the trilinear density (bake.coarse1Mean) and a bound on the fine density's
-// deviation from it (bake.coarse1Residual). The mean field is what candidates track, what the
+// volume/volume.glsl's vol_density) and, on single voxels, the piecewise-constant field of the
+// voxel means of the trilinear density (bake.voxelMean) and a bound on the fine density's
+// deviation from it (bake.voxelResidual). The mean field is what candidates track, what the
 // target's transmittance integrates and the control of final shading's residual ratio tracking.
-// It is positive wherever the fine density is (a cell's mean weighs all its texels positively),
-// so candidates cover the target's support without the dilated field of DESIGN §3: tracking the
-// dilated field made the weights p̂ / p grow like exp(tau_dilated - tau_mean) with depth, and
-// those rare huge weights, kept by temporal reuse, were most of the error (notes/restir.md).
+// It is positive wherever the fine density is (a voxel's mean weighs all its corners
+// positively), so candidates cover the target's support without the dilated field of DESIGN §3:
+// tracking the dilated field made the weights p̂ / p grow like exp(tau_dilated - tau_mean) with
+// depth, and those rare huge weights, kept by temporal reuse, were most of the error. Voxel
+// cells rather than 2³-voxel ones bring p̂ closer to f: relMSE -35% on the bundled smoke for
+// 10-20% more time (notes/restir.md).
 // Coarse tracking: in a piecewise-constant medium the majorant equals the density, so every
 // tentative collision is real and the free-flight pdf is sigma_c(t) exp(-tau_c(0, t)) in closed
 // form, with tau_c the exact optical depth of the coarse field, summed cell by cell with a DDA.
@@ -17,10 +19,10 @@
 
 #include "../shared/dda.h"
 
-// Cells: 2³ voxels, 4³ per brick. The buffer holds, per atlas slot, the 64 cell means then their
-// 64 residual bounds (render/gpu_volume.cpp).
-const int RS_COARSE_PER_BRICK = 4;   // cells per brick edge
-const float RS_COARSE_CELL = 2.0f;   // voxels per cell edge
+// Cells: single voxels, 8³ per brick. The buffer holds, per atlas slot, the 512 voxel means then
+// their 512 residual bounds (render/gpu_volume.cpp).
+const int RS_COARSE_PER_BRICK = 8;   // cells per brick edge
+const float RS_COARSE_CELL = 1.0f;   // voxels per cell edge
 const uint RS_COARSE_MEAN = 0u;      // which field: the trilinear mean
 const uint RS_COARSE_RESIDUAL = 1u;  // bound on |fine - mean| in the cell (residual tracking)
 const float RS_MAX_TAU = 80.0f;      // exp(-80) > 0 in float: p̂ stays strictly positive
@@ -80,7 +82,7 @@ float rsv_coarse_cell(uint v, ivec3 cell, uint field) {
   ivec3 slots = v == 0u ? vol.atlasSlots.xyz : prevVol.atlasSlots.xyz;
   uint index = (slot & 1023u) + uint(slots.x) * (((slot >> 10u) & 1023u) + uint(slots.y) * (slot >> 20u));
   ivec3 c = cell % RS_COARSE_PER_BRICK;
-  uint i = index * 128u + field * 64u + uint((c.z * RS_COARSE_PER_BRICK + c.y) * RS_COARSE_PER_BRICK + c.x);
+  uint i = index * 1024u + field * 512u + uint((c.z * RS_COARSE_PER_BRICK + c.y) * RS_COARSE_PER_BRICK + c.x);
   return v == 0u ? volCoarse[i] : prevCoarse[i];
 }
 

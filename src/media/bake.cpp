@@ -223,27 +223,21 @@ void writeCoarse(BakedVolume& vol, uint32_t slot, const Window& w, float fractio
   for (int z = 0; z < 4; ++z)
     for (int y = 0; y < 4; ++y)
       for (int x = 0; x < 4; ++x) c1[(z * 4 + y) * 4 + x] = mean(2, 2 * x, 2 * y, 2 * z);
-  // The trilinear field's mean over cell c (2 voxels per axis) is sum over voxels 2c + {0,1,2}
-  // of the separable weights (1/4, 1/2, 1/4) (integrate the hat functions over the cell).
-  const float hat[3] = {0.25f, 0.5f, 0.25f};
-  float* m1 = &vol.coarse1Mean[size_t(slot) * 64];
-  float* r1 = &vol.coarse1Residual[size_t(slot) * 64];
-  for (int z = 0; z < 4; ++z)
-    for (int y = 0; y < 4; ++y)
-      for (int x = 0; x < 4; ++x) {
-        double sum = 0.0;
-        for (int k = 0; k < 3; ++k)
-          for (int j = 0; j < 3; ++j)
-            for (int i = 0; i < 3; ++i) sum += hat[k] * hat[j] * hat[i] * w[windowIndex(2 * x + i + 1, 2 * y + j + 1, 2 * z + k + 1)];
-        m1[(z * 4 + y) * 4 + x] = float(sum);
+  float* vm = &vol.voxelMean[size_t(slot) * 512];
+  float* vr = &vol.voxelResidual[size_t(slot) * 512];
+  for (int z = 0; z < 8; ++z)
+    for (int y = 0; y < 8; ++y)
+      for (int x = 0; x < 8; ++x) {
+        double corner[8], sum = 0.0;
+        for (int k = 0; k < 8; ++k) {
+          corner[k] = w[windowIndex(x + 1 + (k & 1), y + 1 + ((k >> 1) & 1), z + 1 + (k >> 2))];
+          sum += corner[k];
+        }
+        const double mean = sum / 8.0;
         double dev = 0.0;
-        for (int k = 0; k < 3; ++k)
-          for (int j = 0; j < 3; ++j)
-            for (int i = 0; i < 3; ++i) {
-              const double t = w[windowIndex(2 * x + i + 1, 2 * y + j + 1, 2 * z + k + 1)];
-              dev = std::max(dev, std::abs(t - sum) + std::abs(t) * 0x1p-10);
-            }
-        r1[(z * 4 + y) * 4 + x] = float(dev);
+        for (double c : corner) dev = std::max(dev, std::abs(c - mean) + std::abs(c) * 0x1p-10);
+        vm[(z * 8 + y) * 8 + x] = float(mean);
+        vr[(z * 8 + y) * 8 + x] = float(dev);
       }
   float* c2 = &vol.coarse2[size_t(slot) * 8];
   for (int z = 0; z < 2; ++z)
@@ -337,8 +331,8 @@ void fillBricks(BakedVolume& vol, const openvdb::FloatGrid& grid, const BrickBox
   else vol.atlasF16.assign(texels, 0);
   vol.coarse1.assign(size_t(vol.slotCount) * 64, 0.0f);
   vol.coarse2.assign(size_t(vol.slotCount) * 8, 0.0f);
-  vol.coarse1Mean.assign(size_t(vol.slotCount) * 64, 0.0f);
-  vol.coarse1Residual.assign(size_t(vol.slotCount) * 64, 0.0f);
+  vol.voxelMean.assign(size_t(vol.slotCount) * 512, 0.0f);
+  vol.voxelResidual.assign(size_t(vol.slotCount) * 512, 0.0f);
   std::vector<float> brickMajorant(box.count(), 0.0f);
   for (const auto& [b, s] : slots) vol.indirection[b] = s;
 

@@ -85,15 +85,14 @@ struct BakedVolume {
   // coarse2[slot*8 + (z*2+y)*2+x]  = mean over voxels 8b + 4(x,y,z) + {0..3}³.
   std::vector<float> coarse1;
   std::vector<float> coarse2;
-  // Not conservative, for approximate transmittance (ReSTIR's target function): the exact mean
-  // of the trilinear field over each coarse1 cell, i.e. weights (1/4, 1/2, 1/4) per axis over
-  // voxels 2c + {0, 1, 2}. coarse1Mean[slot*64 + (z*4+y)*4+x], like coarse1.
-  std::vector<float> coarse1Mean;
-  // Residual majorant of that mean (ReSTIR's final shading: residual ratio tracking against the
-  // mean field): coarse1Residual[slot*64 + ...] >= |d(p) - coarse1Mean| for every p in the cell,
-  // the largest deviation of the cell's 3³ texels (a trilinear field's extremes lie on them),
-  // widened by 2^-10 of each texel to cover float16 storage and interpolation rounding.
-  std::vector<float> coarse1Residual;
+  // Not conservative: ReSTIR's mean field on the GPU (restir/coarse.glsl), on single voxels:
+  // voxelMean[slot*512 + (z*8+y)*8+x] is the mean of the trilinear field over voxel [v, v+1]³
+  // (the mean of its 8 corner texels, which is also the field's value at the voxel's centre);
+  // voxelResidual bounds |d(p) - voxelMean| inside it: the largest corner deviation (a trilinear
+  // field's extremes lie on the corners), widened by 2^-10 of each corner to cover float16
+  // storage and interpolation rounding.
+  std::vector<float> voxelMean;
+  std::vector<float> voxelResidual;
 
   // Index -> world affine map of the grid (column vectors: world = indexToWorld * (i,j,k,1)).
   glm::mat4 indexToWorld{1.0f};

@@ -56,12 +56,12 @@ GpuVolumeResources::GpuVolumeResources(gpu::Context& ctx, const BakedVolume& bak
   indirection_.upload(packed.data(), packed.size() * 4);
   majorants_ = gpu::Buffer(ctx, majorants.size() * 4, storage, "majorant hierarchy");
   majorants_.upload(majorants.data(), majorants.size() * 4);
-  // Per atlas slot 128 floats: the trilinear field's cell means (64) and their residual bounds
-  // (64) (restir/coarse.glsl).
-  std::vector<float> coarse(bake.coarse1Mean.size() * 2);
-  for (size_t slot = 0; slot < bake.coarse1Mean.size() / 64; ++slot) {
-    std::copy_n(&bake.coarse1Mean[slot * 64], 64, &coarse[slot * 128]);
-    std::copy_n(&bake.coarse1Residual[slot * 64], 64, &coarse[slot * 128 + 64]);
+  // Per atlas slot 1024 floats: the trilinear field's voxel means (512) and their residual
+  // bounds (512) (restir/coarse.glsl).
+  std::vector<float> coarse(bake.voxelMean.size() * 2);
+  for (size_t slot = 0; slot < bake.voxelMean.size() / 512; ++slot) {
+    std::copy_n(&bake.voxelMean[slot * 512], 512, &coarse[slot * 1024]);
+    std::copy_n(&bake.voxelResidual[slot * 512], 512, &coarse[slot * 1024 + 512]);
   }
   coarse_ = gpu::Buffer(ctx, coarse.size() * 4, storage, "coarse mip");
   coarse_.upload(coarse.data(), coarse.size() * 4);
