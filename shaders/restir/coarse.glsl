@@ -21,10 +21,6 @@
 
 // Cells: single voxels, 8³ per brick. The buffer holds, per atlas slot, the 512 voxel means then
 // their 512 residual bounds (render/gpu_volume.cpp).
-const int RS_COARSE_PER_BRICK = 8;   // cells per brick edge
-const float RS_COARSE_CELL = 1.0f;   // voxels per cell edge
-const uint RS_COARSE_MEAN = 0u;      // which field: the trilinear mean
-const uint RS_COARSE_RESIDUAL = 1u;  // bound on |fine - mean| in the cell (residual tracking)
 const float RS_MAX_TAU = 80.0f;      // exp(-80) > 0 in float: p̂ stays strictly positive
 
 float rsv_scale(uint v) { return v == 0u ? vol.boundsMin.w : prevVol.boundsMin.w; }
@@ -73,25 +69,63 @@ float rsv_sigma_t(uint v, vec3 xWorld) {
   return rsv_scale(v) * rsv_density(v, o);
 }
 
-// Value of a cell of the coarse DDA grid (cell 0 = first voxel of brick brickOrigin) in one of
-// the two fields (RS_COARSE_MEAN or RS_COARSE_RESIDUAL).
-float rsv_coarse_cell(uint v, ivec3 cell, uint field) {
-  ivec3 origin = v == 0u ? vol.brickOrigin.xyz : prevVol.brickOrigin.xyz;
-  uint slot = rsv_packed_slot(v, origin + cell / RS_COARSE_PER_BRICK);
-  if (slot == 0u) return 0.0f;
-  ivec3 slots = v == 0u ? vol.atlasSlots.xyz : prevVol.atlasSlots.xyz;
-  uint index = (slot & 1023u) + uint(slots.x) * (((slot >> 10u) & 1023u) + uint(slots.y) * (slot >> 20u));
-  ivec3 c = cell % RS_COARSE_PER_BRICK;
-  uint i = index * 1024u + field * 512u + uint((c.z * RS_COARSE_PER_BRICK + c.y) * RS_COARSE_PER_BRICK + c.x);
-  return v == 0u ? volCoarse[i] : prevCoarse[i];
+// A walk along a ray over the voxels of occupied bricks: an outer DDA over bricks, an inner one
+// over the voxels of each occupied brick; an empty brick is one step and the brick's slot is
+// looked up once, not per voxel. Segments come in order and partition the ray inside occupied
+// bricks; the field is 0 elsewhere.
+struct RsWalk {
+  DdaState bricks;
+  DdaState voxels;
+  bool inBrick;
+  uint v;
+  uint base;  // index of the current brick's first mean in volCoarse / prevCoarse
+  ivec3 origin;
+  vec3 o;
+  vec3 d;
+};
+
+bool rs_walk_start(uint v, vec3 o, vec3 d, float tMax, out RsWalk w) {
+  w.inBrick = false;
+  w.v = v;
+  w.base = 0u;
+  w.o = o;
+  w.d = d;
+  w.origin = v == 0u ? vol.brickOrigin.xyz : prevVol.brickOrigin.xyz;
+  if (rsv_empty(v)) return false;
+  ivec3 dims = v == 0u ? vol.brickDims.xyz : prevVol.brickDims.xyz;
+  return dda_init(w.bricks, o, d, 0.0f, tMax, vec3(w.origin * 8), 8.0f, dims);
 }
 
-bool rsv_coarse_start(uint v, vec3 o, vec3 d, float tMax, out DdaState s) {
-  if (rsv_empty(v)) return false;
-  ivec3 origin = v == 0u ? vol.brickOrigin.xyz : prevVol.brickOrigin.xyz;
-  ivec3 dims = v == 0u ? vol.brickDims.xyz : prevVol.brickDims.xyz;
-  return dda_init(s, o, d, 0.0f, tMax, vec3(origin * 8), RS_COARSE_CELL, dims * RS_COARSE_PER_BRICK);
+// The next voxel segment [a, b) in an occupied brick and the voxel's index i in the field buffer
+// (its mean at i, its residual bound at i + 512).
+bool rs_walk_next(inout RsWalk w, out float a, out float b, out uint i) {
+  a = 0.0f;
+  b = 0.0f;
+  i = 0u;
+  for (;;) {
+    if (w.inBrick) {
+      ivec3 c;
+      if (dda_next(w.voxels, a, b, c)) {
+        i = w.base + uint((c.z * 8 + c.y) * 8 + c.x);
+        return true;
+      }
+      w.inBrick = false;
+    }
+    float ba;
+    float bb;
+    ivec3 brick;
+    if (!dda_next(w.bricks, ba, bb, brick)) return false;
+    uint slot = rsv_packed_slot(w.v, w.origin + brick);
+    if (slot == 0u) continue;
+    ivec3 slots = w.v == 0u ? vol.atlasSlots.xyz : prevVol.atlasSlots.xyz;
+    uint index = (slot & 1023u) + uint(slots.x) * (((slot >> 10u) & 1023u) + uint(slots.y) * (slot >> 20u));
+    w.base = index * 1024u;
+    w.inBrick = dda_init(w.voxels, w.o, w.d, ba, bb, vec3((w.origin + brick) * 8), 1.0f, ivec3(8));
+  }
+  return false;
 }
+
+float rs_walk_value(RsWalk w, uint i) { return w.v == 0u ? volCoarse[i] : prevCoarse[i]; }
 
 // Optical depth of the coarse trilinear-mean field over (0, tMax) along a world ray
 // (deterministic; approximates the fine optical depth, not a bound).
@@ -99,14 +133,14 @@ float rs_coarse_tau(uint v, vec3 xWorld, vec3 wWorld, float tMax) {
   vec3 o;
   vec3 d;
   rsv_ray_to_index(v, xWorld, wWorld, o, d);
-  DdaState s;
-  if (!rsv_coarse_start(v, o, d, tMax, s)) return 0.0f;
+  RsWalk w;
+  if (!rs_walk_start(v, o, d, tMax, w)) return 0.0f;
   float scale = rsv_scale(v);
   float tau = 0.0f;
   float a;
   float b;
-  ivec3 cell;
-  while (tau < RS_MAX_TAU && dda_next(s, a, b, cell)) tau += scale * rsv_coarse_cell(v, cell, RS_COARSE_MEAN) * (b - a);
+  uint i;
+  while (tau < RS_MAX_TAU && rs_walk_next(w, a, b, i)) tau += scale * rs_walk_value(w, i) * (b - a);
   return tau;
 }
 
@@ -126,15 +160,15 @@ bool rs_coarse_sample(vec3 xWorld, vec3 wWorld, float tMax, float u, out float t
   vec3 o;
   vec3 d;
   rsv_ray_to_index(0u, xWorld, wWorld, o, d);
-  DdaState s;
-  if (!rsv_coarse_start(0u, o, d, tMax, s)) return false;
+  RsWalk w;
+  if (!rs_walk_start(0u, o, d, tMax, w)) return false;
   float scale = rsv_scale(0u);
   float left = tau;
   float a;
   float b;
-  ivec3 cell;
-  while (dda_next(s, a, b, cell)) {
-    float sigma = scale * rsv_coarse_cell(0u, cell, RS_COARSE_MEAN);
+  uint i;
+  while (rs_walk_next(w, a, b, i)) {
+    float sigma = scale * volCoarse[i];
     float dtau = sigma * (b - a);
     if (sigma > 0.0f && dtau >= left) {
       t = a + left / sigma;
@@ -161,18 +195,18 @@ float rs_residual_tr(vec3 xWorld, vec3 wWorld, float tMax, inout RngState rng) {
   vec3 o;
   vec3 d;
   rsv_ray_to_index(0u, xWorld, wWorld, o, d);
-  DdaState s;
-  if (!rsv_coarse_start(0u, o, d, tMax, s)) return 1.0f;
+  RsWalk w;
+  if (!rs_walk_start(0u, o, d, tMax, w)) return 1.0f;
   float scale = rsv_scale(0u);
   float tau = 0.0f;
   float prod = 1.0f;
   float a;
   float b;
-  ivec3 cell;
-  while (prod != 0.0f && dda_next(s, a, b, cell)) {
-    float mean = scale * rsv_coarse_cell(0u, cell, RS_COARSE_MEAN);
+  uint i;
+  while (prod != 0.0f && rs_walk_next(w, a, b, i)) {
+    float mean = scale * volCoarse[i];
     tau += mean * (b - a);
-    float mu = PLUME_RS_RESIDUAL_SCALE * scale * rsv_coarse_cell(0u, cell, RS_COARSE_RESIDUAL);
+    float mu = PLUME_RS_RESIDUAL_SCALE * scale * volCoarse[i + 512u];
     if (!(mu > 0.0f)) continue;
     float t = a;
     for (;;) {
