@@ -1,5 +1,5 @@
-// ReSTIR passes 2 and 3 (DESIGN §4.2 steps 5-6): temporal reuse (push.sets.w ==
-// RS_PASS_TEMPORAL: the canonical set push.sets.x and the history set push.sets.y at the
+// ReSTIR passes 2 and 3 (DESIGN §4.2 steps 5-6): temporal reuse (PLUME_RS_TEMPORAL 1: the
+// canonical set push.sets.x and the history set push.sets.y at the
 // reprojected pixel, confidence capped) or one spatial round (k neighbours of set push.sets.x
 // within the radius, drawn from the pixel and the round only). Output: set push.sets.z.
 #version 450
@@ -13,9 +13,15 @@ layout(local_size_x = 8, local_size_y = 8) in;
 #include "../restir/bridge.glsl"
 #include "../restir/reuse.glsl"
 
+#ifndef PLUME_RS_TEMPORAL
+#define PLUME_RS_TEMPORAL 0
+#endif
+
+// Compiled twice: PLUME_RS_TEMPORAL 1 (temporal reuse) or 0 (a spatial round), so that each
+// pipeline holds only its own code (see restir/reuse.glsl on PLUME_RS_MIS).
 void main() {
   uvec2 pixel = gl_GlobalInvocationID.xy;
   if (pixel.x >= frame.image.x || pixel.y >= frame.image.y) return;
-  rs_reuse_pixel(pixel, pixel.y * frame.image.x + pixel.x, push.sets.w == RS_PASS_TEMPORAL, push.misc.x, push.sets.x,
+  rs_reuse_pixel(pixel, pixel.y * frame.image.x + pixel.x, PLUME_RS_TEMPORAL != 0, push.misc.x, push.sets.x,
                  push.sets.y, push.sets.z);
 }

@@ -61,11 +61,16 @@ bool rs_light_geometry(GpuLight l, vec3 x, vec2 ls, out vec3 w, out float dist, 
   uint type = uint(l.params.x);
   dist = DDA_INF;
   Le = l.emission.rgb;
+  w = vec3(0.0f, 0.0f, 1.0f);
+  // Light types missing from the scene are compiled out (PLUME_HAS_SUN, _POINT, _ENV).
+#ifdef PLUME_HAS_SUN
   if (type == LIGHT_SUN) {
     // A disk: the stored direction must lie in the cone (up to its float encoding's rounding).
     w = l.params.y <= 0.0f ? l.dirOrPos.xyz : rs_decode_dir(ls);
     return l.params.y <= 0.0f || smp_versine(w, l.dirOrPos.xyz) <= l.params.y * 1.001f;
   }
+#endif
+#ifdef PLUME_HAS_POINT
   if (type == LIGHT_POINT) {
     vec3 toL = l.dirOrPos.xyz - x;
     dist = length(toL);
@@ -74,8 +79,13 @@ bool rs_light_geometry(GpuLight l, vec3 x, vec2 ls, out vec3 w, out float dist, 
     Le = l.emission.rgb / (dist * dist);
     return true;
   }
+#endif
+#ifdef PLUME_HAS_ENV
   w = rs_decode_dir(ls);  // environment
   return true;
+#else
+  return false;
+#endif
 }
 
 // Draws a light sample at x for a path arriving along wIn from light `forced`, or, when forced is
@@ -95,15 +105,23 @@ float rs_sample_light(uint forced, vec3 wIn, float g, vec3 u, out uint light, ou
   uint type = uint(l.params.x);
   float pdf = forced == RS_CHOOSE_LIGHT ? l.params.z : 1.0f;
   ls = vec2(0.0f);
+#ifdef PLUME_HAS_SUN
   if (type == LIGHT_SUN) {
     if (l.params.y <= 0.0f) return pdf;
     ls = rs_encode_dir(smp_uniform_cone(l.dirOrPos.xyz, l.params.y, u.yz));
     vec3 w = rs_decode_dir(ls);
     return smp_versine(w, l.dirOrPos.xyz) <= l.params.y * 1.001f ? pdf * smp_uniform_cone_pdf(l.params.y) : 0.0f;
   }
+#endif
+#ifdef PLUME_HAS_POINT
   if (type == LIGHT_POINT) return pdf;
+#endif
+#ifdef PLUME_HAS_ENV
   ls = rs_encode_dir(ph_hg_sample(wIn, g, u.yz));
   return pdf * ph_hg(dot(rs_decode_dir(ls), wIn), g);
+#else
+  return 0.0f;
+#endif
 }
 
 // Transmittance: the coarse deterministic one (target) or residual ratio tracking on the fine grid

@@ -12,6 +12,10 @@
 #ifndef PLUME_RESTIR_CANDIDATES_GLSL
 #define PLUME_RESTIR_CANDIDATES_GLSL
 
+#ifndef PLUME_RS_ALL_LIGHTS
+#define PLUME_RS_ALL_LIGHTS 1
+#endif
+
 void rs_generate_candidates(uvec2 pixel, uint pixelIndex, uint outSet) {
   RsDomain D = rs_current_domain(pixel);
   RngState rng = rng_init(pixel, frame.seeds.y, RNG_STREAM_CANDIDATES, frame.seeds.x);
@@ -22,7 +26,7 @@ void rs_generate_candidates(uvec2 pixel, uint pixelIndex, uint outSet) {
   float q = min(1.0f, plume_max3(frame.albedo.rgb));
   // Few lights: every vertex ends one candidate per light (as the path tracer's next-event
   // estimation does), each path set with its own pdf; many lights: one light chosen by power.
-  bool allLights = rsp.misc.x != 0u;
+  const bool allLights = PLUME_RS_ALL_LIGHTS != 0;  // compiled in (render/restir.cpp)
   uint lightSamples = allLights ? rsp.frames.w : 1u;
   uint base = rs_bounce_base(outSet, pixelIndex);
   RsReservoir r = rs_empty();

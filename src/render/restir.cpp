@@ -88,19 +88,27 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   const std::vector<BindingType> bindings = {SB, IMG, SB, SB, SB, SB, SB, SB, SB, SB, IMG, SB, SB, SB, SB, SB, SB, SB};
   const gpu::ShaderDefines defines = features_.defines();
   const std::string variant = " [" + features_.name() + "]";
-  auto make = [&](const char* file, const char* name) {
+  // Each pass is compiled with only the code its options use (MIS kind, temporal or spatial,
+  // light sampling): on a SIMD back end such as lavapipe the straight-line code of branches not
+  // taken still runs under a mask (measured: -20 to -40% per reuse pass).
+  const bool allLights = scene.lights.size() <= 4;  // up to 4 lights, every candidate vertex samples each
+  auto make = [&](const char* file, const char* name, gpu::ShaderDefines extra) {
     gpu::ShaderDefines d = defines;
     // Final shading estimates f / p̂ per segment by residual ratio tracking against the target's
     // mean field (restir/coarse.glsl) at 16x the residual majorant: on the bundled smoke (64²,
     // temporal reuse) relMSE 0.011 at 1x, 0.0082 at 2x, 0.0054 at 8x, 0.0046 at 16x, 0.0046 at
     // 32x, shading 3.4 -> 5.9 ms; 16x is where the error stops falling (notes/restir.md).
-    if (std::string(file) == "passes/restir_shade.comp") d.emplace_back("PLUME_RS_RESIDUAL_SCALE", "16.0f");
+    d.emplace_back("PLUME_RS_RESIDUAL_SCALE", "16.0f");
+    d.emplace_back("PLUME_RS_MIS", std::to_string(options_.mis) + "u");
+    d.emplace_back("PLUME_RS_ALL_LIGHTS", allLights ? "1" : "0");
+    d.insert(d.end(), extra.begin(), extra.end());
     return std::make_unique<gpu::ComputePass>(ctx, compiler.compile(file, d), bindings,
                                               uint32_t(sizeof(shared::RsPush)), name + variant, glm::uvec3(8, 8, 1));
   };
-  candidates_ = make("passes/restir_candidates.comp", "restir candidates");
-  reuse_ = make("passes/restir_reuse.comp", "restir reuse");
-  shade_ = make("passes/restir_shade.comp", "restir shade");
+  candidates_ = make("passes/restir_candidates.comp", "restir candidates", {});
+  temporal_ = make("passes/restir_reuse.comp", "restir temporal", {{"PLUME_RS_TEMPORAL", "1"}});
+  spatial_ = make("passes/restir_reuse.comp", "restir spatial", {{"PLUME_RS_TEMPORAL", "0"}});
+  shade_ = make("passes/restir_shade.comp", "restir shade", {});
 
   const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   const size_t pixels = size_t(scene.camera.width) * scene.camera.height;
@@ -116,7 +124,7 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   counters_ = gpu::Buffer(ctx, 16, storage, "restir counters");
   reservoirs_.fillZero();
   paths_.fillZero();
-  for (gpu::ComputePass* p : {candidates_.get(), reuse_.get(), shade_.get()}) {
+  for (gpu::ComputePass* p : {candidates_.get(), temporal_.get(), spatial_.get(), shade_.get()}) {
     p->set.bind(5, frameBuffer_);
     p->set.bind(6, lightBuffer_);
     p->set.bind(7, paramBuffer_);
@@ -129,12 +137,11 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   params_.config = glm::uvec4(uint32_t(options_.candidates), uint32_t(options_.neighbours), options_.mis, stride);
   params_.configF = glm::vec4(float(options_.radius), float(options_.historyCap), 1.0f, 0.0f);
   params_.frames = glm::uvec4(0u, uint32_t(pixels), 0u, uint32_t(scene.lights.size()));
-  // Up to 4 lights, each candidate vertex samples every light; beyond, one light chosen by power.
-  params_.misc = glm::uvec4(scene.lights.size() <= 4 ? 1u : 0u, 0u, 0u, 0u);
+  params_.misc = glm::uvec4(0u);
 }
 
 void Restir::setVolumes(const GpuVolumeResources& current, const GpuVolumeResources& previous) {
-  for (gpu::ComputePass* p : {candidates_.get(), reuse_.get(), shade_.get()}) {
+  for (gpu::ComputePass* p : {candidates_.get(), temporal_.get(), spatial_.get(), shade_.get()}) {
     current.bind(p->set);
     current.bindCoarse(p->set, 8);
     previous.bindAsPrevious(p->set, 9, 10, 11, 12);
@@ -204,7 +211,7 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
     if (temporal) {
       const uint32_t out = (hist + 2) % kSets;
       push.sets = glm::uvec4(cur, hist, out, shared::RS_PASS_TEMPORAL);
-      reuse_->record(cmd, items, &push, &timer_);
+      temporal_->record(cmd, items, &push, &timer_);
       labels.push_back("temporal");
       gpu::computeBarrier(cmd);
       cur = out;
@@ -213,7 +220,7 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
       const uint32_t out = (cur + 1) % kSets;
       push.sets = glm::uvec4(cur, cur, out, shared::RS_PASS_SPATIAL);
       push.misc = glm::uvec4(uint32_t(r), 0u, 0u, 0u);
-      reuse_->record(cmd, items, &push, &timer_);
+      spatial_->record(cmd, items, &push, &timer_);
       labels.push_back(strf("spatial %d", r + 1));
       gpu::computeBarrier(cmd);
       cur = out;

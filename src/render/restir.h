@@ -70,7 +70,7 @@ class Restir {
   const Scene& scene_;
   RestirOptions options_;
   FeatureSet features_;
-  std::unique_ptr<gpu::ComputePass> candidates_, reuse_, shade_;
+  std::unique_ptr<gpu::ComputePass> candidates_, temporal_, spatial_, shade_;
   gpu::GpuTimer timer_;
   gpu::Buffer frameBuffer_, lightBuffer_, paramBuffer_, reservoirs_, paths_, bounces_, output_, counters_;
   shared::GpuFrame frame_{};
