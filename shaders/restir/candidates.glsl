@@ -41,6 +41,7 @@ void rs_generate_candidates(uvec2 pixel, uint pixelIndex, uint outSet) {
     vec3 f = vec3(1.0f);  // prefix of f_D with coarse transmittance (the target's)
     float pdf = 1.0f;     // prefix of the source pdf
     float t1 = 0.0f;
+    uint keep = 0u;  // vertices of this walk's selected candidate (0: none): copied when the walk ends
     for (uint j = 1u; j <= maxVertices; ++j) {
       float t;
       float sigmaC;
@@ -69,7 +70,7 @@ void rs_generate_candidates(uvec2 pixel, uint pixelIndex, uint outSet) {
         if (rs_update(r, weight, ph, 0.0f, rng_to_float(h.w))) {
           head.geo = vec4(t1, ls, 0.0f);
           head.info = uvec4(j, light, 0u, uv);
-          for (uint i = 0u; i + 2u <= j; ++i) rsBounces[base + i] = walk[i];
+          keep = j;
         }
       }
       if (j == maxVertices) break;
@@ -83,6 +84,7 @@ void rs_generate_candidates(uvec2 pixel, uint pixelIndex, uint outSet) {
       f *= phase;
       w = wNext;
     }
+    for (uint i = 0u; i + 2u <= keep; ++i) rsBounces[base + i] = walk[i];
   }
   r.M = float(M);
   rs_finalize(r);
