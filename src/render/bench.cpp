@@ -186,7 +186,7 @@ BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Sce
     const RestirOptions base = restirOptionsOf(scene.render);
     auto add = [&](RestirOptions v) { variants.emplace_back(v.name(), v); };
     // The scene's settings with pairwise MIS and with the generalised balance heuristic; temporal
-    // reuse alone; M 2 and 8; the built-in defaults' 16 px radius (the bundled smoke sets 4 px);
+    // reuse alone; M 2 and 8; the built-in defaults' 16 px radius (the bundled smoke sets 2 px);
     // restir-biased.
     RestirOptions v = base;
     v.mis = shared::RS_MIS_PAIRWISE;
