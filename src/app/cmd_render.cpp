@@ -48,8 +48,8 @@ std::pair<int, int> prerollRange(const Scene& scene, int preroll) {
 }
 
 // ReSTIR frames: `spp` ReSTIR iterations per frame (one sample per pixel each), history kept
-// across iterations and frames; mean and variance of the iterations (correlated by reuse, so the
-// variance is a rough guide only).
+// across iterations and frames; mean and variance of the iterations after the first quarter
+// (correlated by reuse, so the variance is a rough guide only).
 int runRestirRender(const RenderArgs& a, const Scene& scene) {
   const RenderSettings& rs = scene.render;
   a.outputs.check(rs);
@@ -75,10 +75,14 @@ int runRestirRender(const RenderArgs& a, const Scene& scene) {
     auto volume = std::make_unique<GpuVolumeResources>(ctx, bakeVolume(grid, bakeOptions), medium.densityScale);
     restir.setVolumes(*volume, prev ? *prev : *volume);
     // render.spp ReSTIR iterations of the frame, averaged on the device; one read-back per frame.
+    // The first quarter settle the reservoirs on the frame's grid and are not averaged (frame 12
+    // of the bundled smoke, 12 iterations: relMSE 0.00095 averaging all, 0.00075 without the
+    // first 3; every iteration is unbiased, so any subset fixed in advance is).
+    const int settle = rs.spp / 4;
     uint32_t dropped = 0;
     for (int i = 0; i < rs.spp; ++i) {
       if (i == 1) restir.setVolumes(*volume, *volume);
-      restir.render(frame, 0, uint32_t(i), i > 0);
+      restir.render(frame, 0, uint32_t(i), i > settle);
       dropped += restir.lastDroppedCount();
     }
     prev = std::move(volume);
