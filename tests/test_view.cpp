@@ -115,6 +115,31 @@ TEST(View, ScriptedScreenshotIsTheSmokeAndMatchesAnOffscreenRender) {
   EXPECT_LE(worst, 1);
 }
 
+// ReSTIR in the viewer: the display pass reads ReSTIR's device accumulation in place; the
+// presented window must equal the screenshot PNG (written from the read-back mean), and the
+// image is the smoke with the accumulated iteration count.
+TEST(View, RestirWindowShowsItsAccumulatedImage) {
+  if (!haveXvfbRun()) GTEST_SKIP() << "xvfb-run is not installed";
+  const std::string dir = test::outputDir("view_restir");
+  std::string log;
+  const std::vector<std::string> args = {kScene, "--mode", "restir", "--frames", "6", "--screenshot", dir + "/view.png",
+                                         "--capture-window", dir + "/window.png", "--window-scale", "1", "--hide-ui",
+                                         "--width", "64", "--height", "48", "--seed", "3"};
+  ASSERT_EQ(runView(args, log), 0) << log;
+  EXPECT_EQ(log.find("validation:"), std::string::npos) << log;
+  const Image view = readExr(dir + "/view.exr");
+  EXPECT_EQ(view.meta.at("spp"), "6");
+  double lo = 1e30, hi = -1e30;
+  for (size_t i = 0; i < view.pixelCount(); ++i) lo = std::min(lo, luminance(view, i)), hi = std::max(hi, luminance(view, i));
+  EXPECT_GT(hi - lo, 0.05) << "a uniform image is not the smoke";
+  const Rgb8 window = readPng(dir + "/window.png"), png = readPng(dir + "/view.png");
+  ASSERT_EQ(window.width, 64) << "window capture missing or sized wrongly";
+  ASSERT_EQ(png.rgb.size(), window.rgb.size());
+  int worst = 0;
+  for (size_t i = 0; i < png.rgb.size(); ++i) worst = std::max(worst, std::abs(int(png.rgb[i]) - int(window.rgb[i])));
+  EXPECT_LE(worst, 1);
+}
+
 TEST(View, PanelIsDrawnOverTheImageWhenShown) {
   if (!haveXvfbRun()) GTEST_SKIP() << "xvfb-run is not installed";
   const std::string dir = test::outputDir("view");
