@@ -242,8 +242,8 @@ TEST_F(GpuRestir, TemporalAndSpatialStillCameraMatchesReference) {
   expectMatches(run, reference(s, grid, 512), "temporal_still");
 }
 
-// More than four lights: each candidate vertex samples one light chosen in proportion to its
-// estimated power (render/restir.cpp) instead of every light; a dim light must still be found.
+// Five lights: each candidate vertex samples one light chosen in proportion to its estimated
+// power (render/restir.cpp); a dim light must still be found.
 TEST_F(GpuRestir, ManyLightsChosenByPowerMatchReference) {
   Scene s = baseScene(16);
   auto point = [](glm::vec3 p, glm::vec3 intensity) {

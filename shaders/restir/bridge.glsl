@@ -88,22 +88,17 @@ bool rs_light_geometry(GpuLight l, vec3 x, vec2 ls, out vec3 w, out float dist, 
 #endif
 }
 
-// Draws a light sample at x for a path arriving along wIn from light `forced`, or, when forced is
-// RS_CHOOSE_LIGHT, from a light chosen with the probabilities the host stored (params.z, running
-// sums in params.w; render/restir.cpp); the disk uniformly in its cone; the environment by phase
-// sampling. Returns the sample's pdf (in the light's measure, times the light's choice
-// probability unless forced) or 0.
-const uint RS_CHOOSE_LIGHT = 0xFFFFFFFFu;
-float rs_sample_light(uint forced, vec3 wIn, float g, vec3 u, out uint light, out vec2 ls) {
+// Draws a light sample at x for a path arriving along wIn: the light chosen with the
+// probabilities the host stored (params.z, running sums in params.w; render/restir.cpp); the disk
+// uniformly in its cone; the environment by phase sampling. Returns the sample's pdf (in the
+// light's measure, times the light's choice probability) or 0.
+float rs_sample_light(vec3 wIn, float g, vec3 u, out uint light, out vec2 ls) {
   uint n = rsp.frames.w;
-  light = forced;
-  if (forced == RS_CHOOSE_LIGHT) {
-    light = 0u;
-    while (light + 1u < n && u.x >= lights[light].params.w) ++light;
-  }
+  light = 0u;
+  while (light + 1u < n && u.x >= lights[light].params.w) ++light;
   GpuLight l = lights[light];
   uint type = uint(l.params.x);
-  float pdf = forced == RS_CHOOSE_LIGHT ? l.params.z : 1.0f;
+  float pdf = l.params.z;
   ls = vec2(0.0f);
 #ifdef PLUME_HAS_SUN
   if (type == LIGHT_SUN) {

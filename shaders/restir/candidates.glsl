@@ -1,8 +1,9 @@
 // Candidate paths (DESIGN §4.2 step 1). M random walks per pixel, each from its own uniform
 // position (u, v) in the pixel: each vertex's distance comes from coarse tracking in the mean
 // field (pdf sigma_c exp(-tau_c), closed form; restir/coarse.glsl), each further direction from HG
-// sampling, and every vertex ends one candidate per light (few lights) or one with a light
-// chosen by power (many). The candidate ending at vertex j of walk m with light l is the path
+// sampling, and every vertex ends one candidate with a light chosen in proportion to its
+// estimated power (render/restir.cpp restirLights). The candidate ending at vertex j of walk m
+// with light l is the path
 // (u, v, t1, w2, t2, ..., w_j, t_j, l, light sample) with source pdf
 //   p(y) = prod_i sigma_c(x_i) exp(-tau_i) * prod_{i>=2} phase_i * prod q (Russian roulette)
 //          * p_light,
@@ -12,10 +13,6 @@
 #ifndef PLUME_RESTIR_CANDIDATES_GLSL
 #define PLUME_RESTIR_CANDIDATES_GLSL
 
-#ifndef PLUME_RS_ALL_LIGHTS
-#define PLUME_RS_ALL_LIGHTS 1
-#endif
-
 void rs_generate_candidates(uvec2 pixel, uint pixelIndex, uint outSet) {
   RsDomain D = rs_current_domain(pixel);
   RngState rng = rng_init(pixel, frame.seeds.y, RNG_STREAM_CANDIDATES, frame.seeds.x);
@@ -24,10 +21,7 @@ void rs_generate_candidates(uvec2 pixel, uint pixelIndex, uint outSet) {
   uint maxVertices = min(frame.image.w, RS_MAX_VERTICES);
   float g = frame.albedo.w;
   float q = min(1.0f, plume_max3(frame.albedo.rgb));
-  // Few lights: every vertex ends one candidate per light (as the path tracer's next-event
-  // estimation does), each path set with its own pdf; many lights: one light chosen by power.
-  const bool allLights = PLUME_RS_ALL_LIGHTS != 0;  // compiled in (render/restir.cpp)
-  uint lightSamples = allLights ? rsp.frames.w : 1u;
+
   uint base = rs_bounce_base(outSet, pixelIndex);
   RsReservoir r = rs_empty();
   RsPathHead head;
@@ -58,13 +52,11 @@ void rs_generate_candidates(uvec2 pixel, uint pixelIndex, uint outSet) {
       } else {
         walk[j - 2u] = vec4(w, t);
       }
-      for (uint li = 0u; li < lightSamples; ++li) {
-        uvec4 h = rng_next4(rng);
-        uint light;
-        vec2 ls;
-        float pl = rs_sample_light(allLights ? li : RS_CHOOSE_LIGHT, w, g,
-                                   vec3(rng_to_float(h.x), rng_to_float(h.y), rng_to_float(h.z)), light, ls);
-        if (!(pl > 0.0f)) continue;
+      uvec4 h = rng_next4(rng);
+      uint light;
+      vec2 ls;
+      float pl = rs_sample_light(w, g, vec3(rng_to_float(h.x), rng_to_float(h.y), rng_to_float(h.z)), light, ls);
+      if (pl > 0.0f) {
         float ph = rs_luminance(f * rs_light_term(0u, light, ls, x, w, false, rng));
         float weight = invM * ph / (pdf * pl);
         if (rs_update(r, weight, ph, 0.0f, rng_to_float(h.w))) {

@@ -47,7 +47,7 @@ struct RestirParams {
   uvec4 config;   // x: M candidates; y: k neighbours; z: MIS kind (RS_MIS_*); w: bounce stride
   vec4 configF;   // x: spatial radius (px); y: history cap c; z: reprojection depth (world); w: unused
   uvec4 frames;   // x: previous frame number; y: pixel count; z: history valid (0/1); w: light count
-  uvec4 misc;     // x: unused (PLUME_RS_ALL_LIGHTS says how candidates sample lights);
+  uvec4 misc;     // x: unused;
                   // y: 1 = the history's domain is the current one (still camera and volume)
 };
 

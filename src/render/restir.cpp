@@ -35,7 +35,10 @@ namespace {
 // contribution to a scattering point at the volume's centre (phase-averaged: a sun's irradiance
 // or a point light's intensity / r^2 over 4 pi, an environment's radiance), 10% uniform, so no
 // light with a nonzero estimate is starved. A uniform choice spent half the candidates of the
-// bundled smoke on its dim sky.
+// bundled smoke on its dim sky; one candidate per light at every vertex cost more than it gave
+// (bundled smoke at 128², r2: 4.85x -> 5.26x static, 3.79x -> 3.70x moving with one light by
+// power; Blender smoke: 3.53x -> 5.19x and 2.72x -> 3.48x: the sky's light rays through dense
+// smoke carry almost nothing).
 std::vector<shared::GpuLight> restirLights(const Scene& scene, glm::vec3 centre) {
   std::vector<shared::GpuLight> lights = gpuLights(scene);
   const size_t n = scene.lights.size();
@@ -89,9 +92,8 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   const gpu::ShaderDefines defines = features_.defines();
   const std::string variant = " [" + features_.name() + "]";
   // Each pass is compiled with only the code its options use (MIS kind, temporal or spatial,
-  // light sampling): on a SIMD back end such as lavapipe the straight-line code of branches not
+  // light types): on a SIMD back end such as lavapipe the straight-line code of branches not
   // taken still runs under a mask (measured: -20 to -40% per reuse pass).
-  const bool allLights = scene.lights.size() <= 4;  // up to 4 lights, every candidate vertex samples each
   auto make = [&](const char* file, const char* name, gpu::ShaderDefines extra) {
     gpu::ShaderDefines d = defines;
     // Final shading estimates f / p̂ per segment by residual ratio tracking against the target's
@@ -100,7 +102,6 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
     // 32x, shading 3.4 -> 5.9 ms; 16x is where the error stops falling (notes/restir.md).
     d.emplace_back("PLUME_RS_RESIDUAL_SCALE", "16.0f");
     d.emplace_back("PLUME_RS_MIS", std::to_string(options_.mis) + "u");
-    d.emplace_back("PLUME_RS_ALL_LIGHTS", allLights ? "1" : "0");
     d.insert(d.end(), extra.begin(), extra.end());
     return std::make_unique<gpu::ComputePass>(ctx, compiler.compile(file, d), bindings,
                                               uint32_t(sizeof(shared::RsPush)), name + variant, glm::uvec3(8, 8, 1));
