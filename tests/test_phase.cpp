@@ -114,10 +114,8 @@ TEST(Phase, HgSamplingMatchesThePdf) {
       const int j = std::min(kPhiBins - 1, int(phi / (2.0 * kPi) * kPhiBins));
       observed[size_t(std::clamp(i, 0, kCosBins - 1) * kPhiBins + j)] += 1.0;
     }
-    Chi2Result r = chi2Test(observed, expected, kChi2SignificanceLevel, nG);
-    if (!r.pass) writeChi2Report(test::outputDir("phase_hg_" + std::to_string(k)), "chi2", r);
-    EXPECT_TRUE(r.pass) << "g = " << g << " (bins: cos-bin * " << kPhiBins << " + phi-bin)\n"
-                        << r.table;
+    test::expectChi2(observed, expected, "phase_hg_" + std::to_string(k),
+                     "g = " + std::to_string(g) + " (bins: cos-bin * " + std::to_string(kPhiBins) + " + phi-bin)", nG);
     // Convention: wo is the propagation direction after scattering, mean dot(wi, wo) = g.
     const double mean = sumMu / kSamples;
     const double stderr_ = std::sqrt((sumMu2 / kSamples - mean * mean) / kSamples);

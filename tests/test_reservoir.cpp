@@ -59,9 +59,7 @@ void expectFrequencies(const std::vector<double>& counts, const std::vector<doub
     }
   }
   if (std::count_if(e.begin(), e.end(), [](double x) { return x > 0.0; }) < 2) return;
-  Chi2Result chi = chi2Test(counts, e);
-  if (!chi.pass) writeChi2Report(test::outputDir("reservoir_" + name), "chi2", chi);
-  EXPECT_TRUE(chi.pass) << name << "\n" << chi.table;
+  test::expectChi2(counts, e, "reservoir_" + name, name);
 }
 
 const std::vector<std::vector<double>>& weightSets() {

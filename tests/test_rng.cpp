@@ -24,10 +24,7 @@ constexpr int kIndependenceTests = 5;
 constexpr double kCorrelationSigmas = 5.0;
 
 void expectChi2(const std::vector<double>& counts, const std::string& name, int tests = 1) {
-  std::vector<double> expected(counts.size(), kDraws / double(counts.size()));
-  Chi2Result r = chi2Test(counts, expected, kChi2SignificanceLevel, tests);
-  if (!r.pass) writeChi2Report(test::outputDir("rng_" + name), "chi2", r);
-  EXPECT_TRUE(r.pass) << name << "\n" << r.table;
+  test::expectChi2(counts, std::vector<double>(counts.size(), kDraws / double(counts.size())), "rng_" + name, name, tests);
 }
 
 int bin(float u, int bins) { return std::min(bins - 1, int(u * float(bins))); }

@@ -27,9 +27,7 @@ constexpr double kSigmas = 5.0;
 
 void expectChi2(const std::vector<double>& observed, const std::vector<double>& expected,
                 const std::string& name, int tests) {
-  Chi2Result r = chi2Test(observed, expected, kChi2SignificanceLevel, tests);
-  if (!r.pass) writeChi2Report(test::outputDir("sampling_" + name), "chi2", r);
-  EXPECT_TRUE(r.pass) << name << "\n" << r.table;
+  test::expectChi2(observed, expected, "sampling_" + name, name, tests);
 }
 
 // Free-flight distances with extinction sigma: 100 bins equiprobable under sigma_true

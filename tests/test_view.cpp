@@ -62,6 +62,18 @@ double luminance(const Image& img, size_t i) {
   return 0.2126 * img.rgb[3 * i] + 0.7152 * img.rgb[3 * i + 1] + 0.0722 * img.rgb[3 * i + 2];
 }
 
+// The presented window (dir/window.png) equals the screenshot PNG (dir/view.png): the display
+// pass tone-maps on the GPU with the PNG writer's curve; one level of rounding allowed.
+void expectWindowIsTheScreenshot(const std::string& dir, int width, int height) {
+  const Rgb8 window = readPng(dir + "/window.png"), png = readPng(dir + "/view.png");
+  ASSERT_EQ(window.width, width) << "window capture missing or sized wrongly";
+  ASSERT_EQ(window.height, height);
+  ASSERT_EQ(png.rgb.size(), window.rgb.size());
+  int worst = 0;
+  for (size_t i = 0; i < png.rgb.size(); ++i) worst = std::max(worst, std::abs(int(png.rgb[i]) - int(window.rgb[i])));
+  EXPECT_LE(worst, 1);
+}
+
 }  // namespace
 
 TEST(View, ScriptedScreenshotIsTheSmokeAndMatchesAnOffscreenRender) {
@@ -104,15 +116,7 @@ TEST(View, ScriptedScreenshotIsTheSmokeAndMatchesAnOffscreenRender) {
   }
   EXPECT_LT(relMse, 1e-6);
 
-  // The presented window equals the screenshot PNG (the display pass tone-maps on the GPU with
-  // the PNG writer's curve); one level of rounding allowed.
-  const Rgb8 window = readPng(dir + "/window.png"), png = readPng(dir + "/view.png");
-  ASSERT_EQ(window.width, 64) << "window capture missing or sized wrongly";
-  ASSERT_EQ(window.height, 48);
-  ASSERT_EQ(png.rgb.size(), window.rgb.size());
-  int worst = 0;
-  for (size_t i = 0; i < png.rgb.size(); ++i) worst = std::max(worst, std::abs(int(png.rgb[i]) - int(window.rgb[i])));
-  EXPECT_LE(worst, 1);
+  expectWindowIsTheScreenshot(dir, 64, 48);
 }
 
 // ReSTIR in the viewer: the display pass reads ReSTIR's device accumulation in place; the
@@ -132,12 +136,7 @@ TEST(View, RestirWindowShowsItsAccumulatedImage) {
   double lo = 1e30, hi = -1e30;
   for (size_t i = 0; i < view.pixelCount(); ++i) lo = std::min(lo, luminance(view, i)), hi = std::max(hi, luminance(view, i));
   EXPECT_GT(hi - lo, 0.05) << "a uniform image is not the smoke";
-  const Rgb8 window = readPng(dir + "/window.png"), png = readPng(dir + "/view.png");
-  ASSERT_EQ(window.width, 64) << "window capture missing or sized wrongly";
-  ASSERT_EQ(png.rgb.size(), window.rgb.size());
-  int worst = 0;
-  for (size_t i = 0; i < png.rgb.size(); ++i) worst = std::max(worst, std::abs(int(png.rgb[i]) - int(window.rgb[i])));
-  EXPECT_LE(worst, 1);
+  expectWindowIsTheScreenshot(dir, 64, 48);
 }
 
 TEST(View, PanelIsDrawnOverTheImageWhenShown) {

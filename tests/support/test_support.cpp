@@ -1,5 +1,7 @@
 #include "support/test_support.h"
 
+#include "core/stats.h"
+
 #include <gtest/gtest.h>
 
 #include <array>
@@ -52,6 +54,13 @@ RunResult runPlume(const std::vector<std::string>& args) {
   int status = pclose(pipe);
   result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return result;
+}
+
+void expectChi2(const std::vector<double>& observed, const std::vector<double>& expected, const std::string& dirName,
+                const std::string& what, int testCount) {
+  const Chi2Result r = chi2Test(observed, expected, kChi2SignificanceLevel, testCount);
+  if (!r.pass) writeChi2Report(outputDir(dirName), "chi2", r);
+  EXPECT_TRUE(r.pass) << what << "\n" << r.table;
 }
 
 }  // namespace plume::test

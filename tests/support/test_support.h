@@ -18,4 +18,10 @@ struct RunResult {
 // Runs `plume` with the arguments (shell-quoted for you).
 RunResult runPlume(const std::vector<std::string>& args);
 
+// Chi-square test of observed against expected counts at the suite's level, Šidák-corrected for
+// `testCount` tests; on failure the report goes to outputDir(dirName) and the message names
+// `what`.
+void expectChi2(const std::vector<double>& observed, const std::vector<double>& expected, const std::string& dirName,
+                const std::string& what, int testCount = 1);
+
 }  // namespace plume::test
