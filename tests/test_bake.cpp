@@ -249,8 +249,9 @@ TEST(Bake, CoarseCheckDetectsAMissingDilation) {
 }
 
 TEST(Bake, EmptyGridBakesToNothing) {
-  for (auto g : {openvdb::FloatGrid::create(0), openvdb::FloatGrid::create(0)}) {
-    g->tree().setValue(Coord(3, 4, 5), 0.0f);  // the second loop: active but zero
+  for (const bool activeZero : {false, true}) {
+    auto g = openvdb::FloatGrid::create(0);
+    if (activeZero) g->tree().setValue(Coord(3, 4, 5), 0.0f);  // an active voxel whose value is 0
     const BakedVolume vol = bakeVolume(wrap(g));
     EXPECT_EQ(vol.stats.allocatedBricks, 0u);
     EXPECT_TRUE(vol.empty());
@@ -347,7 +348,13 @@ TEST(Bake, VoxelMeanAndResidualBoundDescribeTheTrilinearFieldAndCoverItsSupport)
             const double mean = vol.voxelMean[size_t(slot) * 512 + size_t(c)];
             const double bound = vol.voxelResidual[size_t(slot) * 512 + size_t(c)];
             const double centre = sampleDensity(vol, lo + 0.5f);
-            ASSERT_NEAR(mean, centre, 2e-3 * std::max(1.0, centre)) << "brick " << bx << "," << by << "," << bz << " voxel " << c;
+            // Exact but for storage and float arithmetic: the mean is taken from the float values,
+            // the centre lookup from the stored texels (float16: 2^-11 relative rounding of each
+            // corner) with float trilinear weights; every corner is <= mean + bound. The 1e-7
+            // absolute floor: near-zero voxels (mean 1.25e-8) look up 1.49e-8 = 2^-26 in float32,
+            // not yet explained (notes/status.md); before this test had 2e-3 absolute.
+            const double tol = (format == TexelFormat::Float16 ? 0x1p-10 : 1e-5) * (mean + bound) + 1e-7;
+            ASSERT_NEAR(mean, centre, tol) << "brick " << bx << "," << by << "," << bz << " voxel " << c;
             double worst = 0;
             for (int k = 0; k < 32; ++k) {
               const double d = sampleDensity(vol, lo + glm::vec3(u(rng), u(rng), u(rng)));

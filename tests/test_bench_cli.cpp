@@ -1,8 +1,8 @@
 // `plume bench` (issue 4, DESIGN §6) end to end on a tiny image: it builds and caches the
 // reference next to the scene, runs the path tracer curve and the selected ReSTIR variants for a
 // static and a moving camera, and writes a table, a CSV and an SVG whose numbers are sane
-// (finite positive errors and times, the path tracer's error falling with its spp, a gain for
-// every ReSTIR row). A second run reuses the cached reference; an edited scene does not.
+// (finite positive errors and times, the path tracer's error falling with its spp, a finite
+// positive gain for every ReSTIR row: a sanity check, the gains themselves are a benchmark). A second run reuses the cached reference; an edited scene does not.
 #include "io/image.h"
 #include "support/test_support.h"
 

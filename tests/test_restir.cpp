@@ -169,6 +169,13 @@ TEST(RestirMis, PairwiseAndGbhWeightsSumToOne) {
     for (int i = 0; i <= k; ++i) denom += M[i] * ph[i];
     for (int i = 0; i <= k; ++i) gbh += shared::rs_gbh(M[i], ph[i], denom);
     EXPECT_NEAR(gbh, 1.0f, 1e-5f);
+    // Sums to 1 hold for any share function; the share itself is the pair's balance heuristic,
+    // written out here, 0 when neither technique can produce the path.
+    for (int i = 1; i <= k; ++i) {
+      const float a = M[i] * ph[i], d = a + M[0] * ph[0];
+      EXPECT_NEAR(shared::rs_pair_share(M[i], ph[i], M[0], ph[0]), d > 0 ? a / d : 0.0f, 1e-6f);
+    }
+    EXPECT_EQ(shared::rs_pair_share(2.0f, 0.0f, 3.0f, 0.0f), 0.0f);
   }
 }
 

@@ -52,6 +52,10 @@ std::pair<int, int> prerollRange(const Scene& scene, int preroll) {
 // (correlated by reuse, so the variance is a rough guide only).
 int runRestirRender(const RenderArgs& a, const Scene& scene) {
   const RenderSettings& rs = scene.render;
+  if (rs.spp > int(Restir::kMaxIterations)) {
+    throw InputError(scene.path + strf(": render.spp: at most %u ReSTIR iterations per frame (got %d)",
+                                       Restir::kMaxIterations, rs.spp));
+  }
   a.outputs.check(rs);
   BakeOptions bakeOptions;
   bakeOptions.format = a.texels == "float32" ? TexelFormat::Float32 : TexelFormat::Float16;

@@ -53,6 +53,13 @@ double referenceOwnRelMse(const Image& ref) {
   return ref.rgb.empty() ? 0 : sum / double(ref.rgb.size());
 }
 
+// Creates a folder (and its parents); an unwritable place is bad input, not a crash.
+void makeFolder(const fs::path& dir) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw InputError("bench: cannot create " + dir.string() + ": " + ec.message());
+}
+
 // What the reference's pixels depend on besides its file name's fields: the scene file's text, the
 // grid file's size and time, the path length settings. An edited scene or a re-baked grid gets
 // a new reference, never a stale one.
@@ -90,7 +97,7 @@ Image loadOrBuildReference(gpu::Context& ctx, gpu::ShaderCompiler& compiler, con
   pt.beginFrame(frame);
   for (int done = 0; done < refSpp; done += 32) pt.addSamples(std::min(32, refSpp - done));
   Image ref = pt.readImage();
-  fs::create_directories(fs::path(path).parent_path());
+  makeFolder(fs::path(path).parent_path());
   writeExr(path, ref);
   return ref;
 }
@@ -180,7 +187,7 @@ BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Sce
   BenchResult result;
   result.device = ctx.deviceName();
   const std::string dir = o.outDir.empty() ? (fs::path(scene.dir) / "bench_out").string() : o.outDir;
-  fs::create_directories(dir);
+  makeFolder(dir);
   std::vector<std::pair<std::string, RestirOptions>> variants = o.variants;
   if (variants.empty()) {
     const RestirOptions base = restirOptionsOf(scene.render);
@@ -252,16 +259,18 @@ BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Sce
         Image im;
         double ms = 0;
         PassTimes times;
+        const bool warmup = f < first + o.warmup;  // rendered, not read back
         if (m.pt) {
           m.pt->beginFrame(f);
           m.pt->addSamples(m.ptSpp);
-          im = m.pt->readImage();
+          if (!warmup) im = m.pt->readImage();
           times = m.pt->lastPassTimes();
         } else {
-          im = m.restir->renderFrame(f);
+          m.restir->render(f, 0, 0, false);
+          if (!warmup) im = m.restir->readImage();
           times = m.restir->lastPassTimes();
         }
-        if (f < first + o.warmup) continue;
+        if (warmup) continue;
         for (const auto& [n, t] : times) ms += t, m.passMs[n].push_back(t);
         const Image& ref = moving ? refs.at(f) : refs.begin()->second;
         m.ms.push_back(ms);

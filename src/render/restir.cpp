@@ -192,7 +192,8 @@ Image Restir::renderFrame(int frame, uint32_t sequence, uint32_t iteration) {
 Image Restir::readImage() const { return readAccumulation(output_, scene_.camera.width, scene_.camera.height); }
 
 void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accumulate) {
-  const uint32_t key = uint32_t(frame) * 1024u + iteration;
+  PLUME_CHECK(iteration < kMaxIterations);
+  const uint32_t key = uint32_t(frame) * kMaxIterations + iteration;
   fillFrame(frame, sequence, key);
   const bool temporal = params_.frames.z != 0u;
   const uint32_t zero[4] = {0, 0, 0, 0};

@@ -50,7 +50,9 @@ class Restir {
   // Renders `frame` (camera pose of that frame) with seed render.seed + 0x9E3779B9 * sequence:
   // independent sequences for the same frame are decorrelated. Returns the frame's image (one
   // ReSTIR sample per pixel; its variance channel is 0). `iteration` > 0 renders the same frame again
-  // with fresh random numbers (the random streams are keyed by frame * 1024 + iteration).
+  // with fresh random numbers (the random streams are keyed by frame * 1024 + iteration, so
+  // iteration < kMaxIterations).
+  static constexpr uint32_t kMaxIterations = 1024;
   Image renderFrame(int frame, uint32_t sequence = 0, uint32_t iteration = 0);
   // The same without the read-back: the frame's final shading restarts the accumulation on the
   // device (accumulate = false) or is averaged into it (true); readImage gives the mean and the

@@ -42,8 +42,10 @@ class RestirView final : public ViewRenderer {
     samples_ = 0;
   }
   void addSamples(int spp) override {
-    for (int i = 0; i < spp && iteration_ < kMaxIterations; ++i, ++samples_) {
-      restir_.render(frame_, 0, iteration_++, samples_ > 0);
+    // Random streams are keyed frame * 1024 + iteration: every 1024 iterations the viewer moves
+    // to the next seed sequence (a fresh history) instead of reusing numbers or stopping.
+    for (int i = 0; i < spp; ++i, ++samples_, ++iteration_) {
+      restir_.render(frame_, iteration_ / Restir::kMaxIterations, iteration_ % Restir::kMaxIterations, samples_ > 0);
     }
   }
   int samplesSoFar() const override { return samples_; }
@@ -52,7 +54,6 @@ class RestirView final : public ViewRenderer {
   PassTimes lastPassTimes() const override { return restir_.lastPassTimes(); }
 
  private:
-  static constexpr uint32_t kMaxIterations = 1024;  // random streams are keyed frame * 1024 + iteration
   Restir restir_;
   int frame_ = 0;
   uint32_t iteration_ = 0;
