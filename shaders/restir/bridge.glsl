@@ -1,7 +1,7 @@
 // The bridge between ReSTIR's algorithm (shared/reservoir.h, shared/restir_types.h) and our
-// resources: domains (a pixel of a frame, with that frame's volume), the path
-// contribution f_D(y) — approximate (the target p̂) or unbiased (final shading) — candidate
-// generation, reservoir storage, and the one reuse step shared by the temporal and spatial passes.
+// resources: domains (a pixel of a frame, with that frame's volume), lights, the path
+// contribution f_D(y) — approximate (the target p̂) or unbiased (final shading) — and reservoir
+// and path storage. Candidates and the reuse step build on it (candidates.glsl, reuse.glsl).
 // Requires restir/bindings.glsl, volume/volume.glsl (unbiased tracking on the current volume)
 // and restir/coarse.glsl.
 #ifndef PLUME_RESTIR_BRIDGE_GLSL
@@ -186,7 +186,7 @@ vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool unbiased, 
 
 // The target function p̂_D(y): deterministic (no random numbers are drawn on this path).
 float rs_target(RsDomain D, uint set, uint pixelIndex) {
-  RngState unused = rng_init(uvec2(0u), 0u, 0u, 0u);
+  RngState unused = RngState(uvec4(0u), 0u);  // never drawn from: no hash to pay for
   return rs_luminance(rs_path_contribution(D, set, pixelIndex, false, unused));
 }
 

@@ -27,8 +27,6 @@ const uint RS_MIS_PAIRWISE = 0u;  // pairwise MIS with confidence weights (defau
 const uint RS_MIS_GBH = 1u;       // generalised balance heuristic (O(k^2))
 const uint RS_MIS_BIASED = 2u;    // restir-biased: m_i = M_i / sum M, no MIS (biased)
 
-const uint RS_PASS_TEMPORAL = 0u;
-const uint RS_PASS_SPATIAL = 1u;
 
 // Stored path header (one per pixel and reservoir set); vertices 2..n live in a separate buffer
 // of vec4(direction, t), RestirParams.config.w (= max_bounces - 1) slots per pixel and set.
@@ -44,16 +42,16 @@ struct RestirParams {
   vec4 prevCamForward;
   vec4 prevCamRight;
   vec4 prevCamUp;
-  uvec4 config;   // x: M candidates; y: k neighbours; z: MIS kind (RS_MIS_*); w: bounce stride
+  uvec4 config;   // x: M candidates; y: k neighbours; z: unused (PLUME_RS_MIS); w: bounce stride
   vec4 configF;   // x: spatial radius (px); y: history cap c; z: reprojection depth (world); w: unused
-  uvec4 frames;   // x: previous frame number; y: pixel count; z: history valid (0/1); w: light count
+  uvec4 frames;   // x: unused; y: pixel count; z: history valid (0/1); w: light count
   uvec4 misc;     // x: unused;
                   // y: 1 = the history's domain is the current one (still camera and volume)
 };
 
 // Push constants: which reservoir sets a pass reads and writes.
 struct RsPush {
-  uvec4 sets;  // x: canonical input set; y: neighbour input set; z: output set; w: pass kind
+  uvec4 sets;  // x: canonical input set; y: history set; z: output set; w: unused (PLUME_RS_TEMPORAL)
   uvec4 misc;  // x: spatial round; y: shading restarts the accumulation (1) or adds to it (0)
 };
 

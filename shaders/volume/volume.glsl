@@ -10,13 +10,6 @@
 
 const int VOL_BRICK = 8;
 const int VOL_TEXELS = 10;
-// Ratio tracking's majorant is the brick majorant times this factor. With a tight majorant
-// ratio tracking degenerates towards a 0/1 estimate (high variance where T is small); a looser
-// one takes more steps and gives smoother estimates. Passes choose it (a #define): a cost /
-// variance trade-off measured with `plume bench`.
-#ifndef PLUME_RT_MAJORANT_SCALE
-#define PLUME_RT_MAJORANT_SCALE 1.0f
-#endif
 const uint VOL_MAX_STEPS = 1u << 20;  // per tracking call; hits are counted in volCounters[0]
 
 // The indirection holds each brick's atlas slot as packed slot coordinates (10 bits per axis,
@@ -180,7 +173,6 @@ float vol_ratio_tracking(vec3 oWorld, vec3 dWorld, float tMax, inout RngState rn
   float b;
   float maj;
   while (tr > 0.0f && vol_segments_next(walk, a, b, maj)) {
-    maj *= PLUME_RT_MAJORANT_SCALE;
     if (maj <= 0.0f) continue;
     float t = a;
     for (;;) {

@@ -135,7 +135,7 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
     p->set.bind(16, output_);
     p->set.bind(17, counters_);
   }
-  params_.config = glm::uvec4(uint32_t(options_.candidates), uint32_t(options_.neighbours), options_.mis, stride);
+  params_.config = glm::uvec4(uint32_t(options_.candidates), uint32_t(options_.neighbours), 0u, stride);
   params_.configF = glm::vec4(float(options_.radius), float(options_.historyCap), 1.0f, 0.0f);
   params_.frames = glm::uvec4(0u, uint32_t(pixels), 0u, uint32_t(scene.lights.size()));
   params_.misc = glm::uvec4(0u);
@@ -170,7 +170,6 @@ void Restir::fillFrame(int frame, uint32_t sequence, uint32_t key) {
     params_.prevCamRight = prevCam_[2];
     params_.prevCamUp = prevCam_[3];
   }
-  params_.frames.x = prevKey_;
   params_.frames.z = history ? 1u : 0u;
   // The history's domain is the current one (a still camera over the grid it was rendered with):
   // the temporal shift is the identity and both cross-domain targets are the stored ones.
@@ -212,7 +211,7 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
     gpu::computeBarrier(cmd);
     if (temporal) {
       const uint32_t out = (hist + 2) % kSets;
-      push.sets = glm::uvec4(cur, hist, out, shared::RS_PASS_TEMPORAL);
+      push.sets = glm::uvec4(cur, hist, out, 0u);
       temporal_->record(cmd, items, &push, &timer_);
       labels.push_back("temporal");
       gpu::computeBarrier(cmd);
@@ -220,7 +219,7 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
     }
     for (int r = 0; r < options_.rounds; ++r) {
       const uint32_t out = (cur + 1) % kSets;
-      push.sets = glm::uvec4(cur, cur, out, shared::RS_PASS_SPATIAL);
+      push.sets = glm::uvec4(cur, cur, out, 0u);
       push.misc = glm::uvec4(uint32_t(r), 0u, 0u, 0u);
       spatial_->record(cmd, items, &push, &timer_);
       labels.push_back(strf("spatial %d", r + 1));
@@ -237,7 +236,6 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
   for (size_t i = 0; i < passTimes_.size() && i < labels.size(); ++i) passTimes_[i].first = labels[i];
   history_ = finalSet;
   hasHistory_ = true;
-  prevKey_ = key;
   prevSequence_ = sequence;
   uint32_t counters[4];
   counters_.download(counters, sizeof counters);

@@ -1,7 +1,7 @@
 // What the viewer drives, whatever the estimator: begin a frame (camera, animation frame and
 // parameters taken from the Scene the renderer was built with), add samples progressively, read
 // the image back. `makeViewRenderer` is the one place where the viewer dispatches on
-// render.mode; the ReSTIR renderer plugs in there (see the comment in view_renderer.cpp).
+// render.mode (pt, restir, restir-biased).
 #pragma once
 
 #include "gpu/context.h"

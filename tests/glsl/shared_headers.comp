@@ -76,8 +76,7 @@ void main() {
   vec3 wd = rs_decode_dir(rs_encode_dir(wo));
   float mis = rs_pairwise_neighbour(1.0f, p, 2.0f, pc, 3.0f) + rs_pairwise_canonical_term(1.0f, p, 2.0f, pc, 3.0f) +
               rs_pair_share(1.0f, p, 1.0f, pc) + rs_gbh(1.0f, p, 2.0f) +
-              float(RS_MAX_VERTICES + RS_MAX_NEIGHBOURS + RS_MIS_PAIRWISE + RS_MIS_GBH + RS_MIS_BIASED +
-                    RS_PASS_TEMPORAL + RS_PASS_SPATIAL);
+              float(RS_MAX_VERTICES + RS_MAX_NEIGHBOURS + RS_MIS_PAIRWISE + RS_MIS_GBH + RS_MIS_BIASED);
   s += wd * mis;
   values[i] = vec4(s + wo, t + m + (picked ? 1.0f : 0.0f) + (dropped ? 2.0f : 0.0f) +
                    (rs_is_finite(back.W) ? back.W : 0.0f));
