@@ -146,16 +146,15 @@ bool checkPoint(const BakedVolume& vol, const openvdb::FloatGrid& grid,
   const double tolBox = tolExact + kF32Rel * lmax;
   const float maj = sampleMajorant(vol, p);
   char buf[400];
-  std::snprintf(buf, sizeof buf, "p=(%.7g %.7g %.7g) baked=%.9g box=%.9g exact=%.9g majorant=%.9g c1=%.9g c2=%.9g",
-                p.x, p.y, p.z, d, box, exact, maj, sampleCoarse(vol, 1, p), sampleCoarse(vol, 2, p));
+  std::snprintf(buf, sizeof buf, "p=(%.7g %.7g %.7g) baked=%.9g box=%.9g exact=%.9g majorant=%.9g mean=%.9g",
+                p.x, p.y, p.z, d, box, exact, maj, sampleVoxelMean(vol, p));
   why = buf;
   if (std::abs(d - exact) > tolExact) return why += " [vs exact]", false;
   if (std::abs(d - box) > tolBox) return why += " [vs BoxSampler]", false;
   if (maj < d || maj < box) return why += " [majorant]", false;
   for (int l = 1; l < int(vol.maxLevels.size()); ++l)
     if (sampleMaxLevel(vol, l, p) < sampleMaxLevel(vol, l - 1, p)) return why += " [hierarchy]", false;
-  if ((d > 0 || box > 0) && !(sampleCoarse(vol, 1, p) > 0 && sampleCoarse(vol, 2, p) > 0))
-    return why += " [coarse not conservative]", false;
+  if ((d > 0 || box > 0) && !(sampleVoxelMean(vol, p) > 0)) return why += " [mean field misses density]", false;
   return true;
 }
 
@@ -231,21 +230,8 @@ TEST(Bake, BricksSeeingOnlyANeighboursVoxelAreAllocated) {
   EXPECT_EQ(sampleDensity(vol, glm::vec3(9.0f, 8.0f, 8.0f)), 0.0f);
   EXPECT_NEAR(sampleMajorant(vol, glm::vec3(7.5f)), 1.0f, 1e-5);  // 1 plus the rounding margin
   EXPECT_GE(sampleMajorant(vol, glm::vec3(7.5f)), 1.0f);
-  EXPECT_GT(sampleCoarse(vol, 1, glm::vec3(7.01f)), 0.0f);  // dilated: (7,7,7) is next to (8,8,8)
-  EXPECT_GT(sampleCoarse(vol, 2, glm::vec3(7.01f)), 0.0f);
-  EXPECT_EQ(sampleCoarse(vol, 1, glm::vec3(5.5f)), 0.0f);   // cell (4..5)³ sees nothing
-}
-
-// The edge points really probe the dilation: without it, the coarse mips miss density.
-TEST(Bake, CoarseCheckDetectsAMissingDilation) {
-  auto g = makeNoisyGrid();
-  BakeOptions opt;
-  opt.dilationFraction = 0.0f;
-  const BakedVolume vol = bakeVolume(wrap(g), opt);
-  size_t missed = 0;
-  for (const glm::vec3& p : testPoints(*g, 30000, 11))
-    missed += sampleDensity(vol, p) > 0 && !(sampleCoarse(vol, 1, p) > 0);
-  EXPECT_GT(missed, 100u);
+  EXPECT_FLOAT_EQ(sampleVoxelMean(vol, glm::vec3(7.01f)), 0.125f);  // voxel (7,7,7): one corner of 8 is 1
+  EXPECT_EQ(sampleVoxelMean(vol, glm::vec3(6.5f)), 0.0f);           // voxel (6,6,6) sees nothing
 }
 
 TEST(Bake, EmptyGridBakesToNothing) {
@@ -261,7 +247,7 @@ TEST(Bake, EmptyGridBakesToNothing) {
       const glm::vec3 p(u(rng), u(rng), u(rng));
       EXPECT_EQ(sampleDensity(vol, p), 0.0f);
       EXPECT_EQ(sampleMajorant(vol, p), 0.0f);
-      EXPECT_EQ(sampleCoarse(vol, 1, p), 0.0f);
+      EXPECT_EQ(sampleVoxelMean(vol, p), 0.0f);
       EXPECT_EQ(sampleMaxLevel(vol, 1, p), 0.0f);
     }
   }
@@ -314,7 +300,7 @@ TEST(Bake, AtlasLayoutHoldsEverySlot) {
   EXPECT_EQ(vol.atlasTexels, s * kBrickTexels);
   EXPECT_EQ(vol.atlasF16.size(), size_t(vol.atlasTexels.x) * vol.atlasTexels.y * vol.atlasTexels.z);
   EXPECT_TRUE(vol.atlasF32.empty());
-  EXPECT_EQ(vol.coarse1.size(), size_t(vol.slotCount) * 64);
+  EXPECT_EQ(vol.voxelMean.size(), size_t(vol.slotCount) * 512);
   for (int i = 0; i < kBrickTexelCount; ++i) EXPECT_EQ(vol.atlasF16[size_t(i % 10 + (i / 10 % 10) * vol.atlasTexels.x + (i / 100) * vol.atlasTexels.x * vol.atlasTexels.y)], 0);
   const glm::ivec3 last = slotTexelOrigin(vol, vol.slotCount - 1);
   EXPECT_TRUE(glm::all(glm::lessThanEqual(last + kBrickTexels, vol.atlasTexels)));

@@ -1,5 +1,5 @@
 // Resources of the ReSTIR passes (src/render/restir.cpp binds them in this order). Bindings 0..4
-// are the current volume (volume/bindings.glsl); 8..12 its coarse mip and the previous frame's
+// are the current volume (volume/bindings.glsl); 8..12 its mean field and the previous frame's
 // volume (the same resources as the current one for a still grid), which the target function of
 // the temporal domain reads (DESIGN §4.2 step 5).
 #ifndef PLUME_RESTIR_BINDINGS_GLSL

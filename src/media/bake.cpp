@@ -1,12 +1,12 @@
 // The bake (DESIGN §3): OpenVDB float grid -> bricks in an atlas, indirection, majorant
-// hierarchy and coarse conservative mips. See bake.h for the layout; lookups are in bake_lookup.cpp.
+// hierarchy and ReSTIR's voxel mean field. See bake.h for the layout; lookups are in bake_lookup.cpp.
 //
 // Pipeline (every pass parallel over bricks with TBB):
 //   1. core bricks: bricks whose own 8³ voxels hold a non-zero value (leaves and active tiles);
 //   2. candidates: core bricks dilated by one brick (only those can see a non-zero voxel in their
 //      10³ window, whose apron reaches one voxel into each neighbour);
 //   3. allocate the candidates whose window holds a non-zero voxel (core bricks always do);
-//   4. fill each allocated slot: texels, majorant, coarse cells; then the max hierarchy.
+//   4. fill each allocated slot: texels, majorant, mean field; then the max hierarchy.
 #include "media/bake.h"
 
 #include "core/error.h"
@@ -173,56 +173,8 @@ SlotResult writeTexels(BakedVolume& vol, uint32_t slot, const Window& w) {
   return r;
 }
 
-// Dilated interior voxels (window 1..8 on each axis, stored x fastest in 8³): the voxel itself
-// if positive, else `fraction` of the max of its 26 neighbours, kept >= FLT_MIN (fraction 0
-// turns dilation off: the coarse mips are then not conservative, a test checks it).
-// The 3³ box max is separable: 1D maxima along x, then y, then z (all inside the window).
-void dilateInterior(const Window& w, float fraction, std::array<float, 512>& out) {
-  std::array<float, 8 * 10 * 10> mx;  // [z][y][x-1], x in 1..8
-  for (int z = 0; z < 10; ++z)
-    for (int y = 0; y < 10; ++y)
-      for (int x = 1; x <= 8; ++x) {
-        const float* r = &w[windowIndex(x, y, z)];
-        mx[(z * 10 + y) * 8 + x - 1] = std::max({r[-1], r[0], r[1]});
-      }
-  std::array<float, 8 * 8 * 10> my;  // [z][y-1][x-1]
-  for (int z = 0; z < 10; ++z)
-    for (int y = 1; y <= 8; ++y)
-      for (int x = 0; x < 8; ++x) {
-        const float* c = &mx[(z * 10 + y) * 8 + x];
-        my[(z * 8 + y - 1) * 8 + x] = std::max({c[-8], c[0], c[8]});
-      }
-  for (int z = 1; z <= 8; ++z)
-    for (int y = 0; y < 8; ++y)
-      for (int x = 0; x < 8; ++x) {
-        const float* c = &my[(z * 8 + y) * 8 + x];
-        const float m = std::max({c[-64], c[0], c[64]});  // max over the 3³ box
-        const float v = w[windowIndex(x + 1, y + 1, z)];
-        float d = v;
-        if (!(v > 0.0f) && m > 0.0f && fraction > 0.0f) d = std::max(fraction * m, std::numeric_limits<float>::min());
-        out[((z - 1) * 8 + y) * 8 + x] = d;
-      }
-}
-
-// Coarse cells of one brick. Why this is conservative: if d(p) > 0 with floor(p) = v in the
-// brick, one of the corners v + {0,1}³ is positive, so v itself or a 26-neighbour is, so the
-// dilated value at v is > 0; v lies in the coarse cell containing p (cells are aligned to
-// 2 or 4 voxels), and a mean of non-negative values with one positive term is positive.
-void writeCoarse(BakedVolume& vol, uint32_t slot, const Window& w, float fraction) {
-  std::array<float, 512> dil;  // interior voxels, x fastest
-  dilateInterior(w, fraction, dil);
-  auto mean = [&](int cell, int x0, int y0, int z0) {
-    double sum = 0.0;
-    for (int z = z0; z < z0 + cell; ++z)
-      for (int y = y0; y < y0 + cell; ++y)
-        for (int x = x0; x < x0 + cell; ++x) sum += dil[(z * 8 + y) * 8 + x];
-    const float m = float(sum / double(cell * cell * cell));
-    return sum > 0.0 ? std::max(m, std::numeric_limits<float>::min()) : 0.0f;  // no underflow to 0
-  };
-  float* c1 = &vol.coarse1[size_t(slot) * 64];
-  for (int z = 0; z < 4; ++z)
-    for (int y = 0; y < 4; ++y)
-      for (int x = 0; x < 4; ++x) c1[(z * 4 + y) * 4 + x] = mean(2, 2 * x, 2 * y, 2 * z);
+// ReSTIR's mean field of one brick (bake.h voxelMean, voxelResidual).
+void writeMeanField(BakedVolume& vol, uint32_t slot, const Window& w) {
   float* vm = &vol.voxelMean[size_t(slot) * 512];
   float* vr = &vol.voxelResidual[size_t(slot) * 512];
   for (int z = 0; z < 8; ++z)
@@ -236,13 +188,9 @@ void writeCoarse(BakedVolume& vol, uint32_t slot, const Window& w, float fractio
         const double mean = sum / 8.0;
         double dev = 0.0;
         for (double c : corner) dev = std::max(dev, std::abs(c - mean) + std::abs(c) * 0x1p-10);
-        vm[(z * 8 + y) * 8 + x] = float(mean);
+        vm[(z * 8 + y) * 8 + x] = sum > 0.0 ? std::max(float(mean), std::numeric_limits<float>::min()) : 0.0f;
         vr[(z * 8 + y) * 8 + x] = float(dev);
       }
-  float* c2 = &vol.coarse2[size_t(slot) * 8];
-  for (int z = 0; z < 2; ++z)
-    for (int y = 0; y < 2; ++y)
-      for (int x = 0; x < 2; ++x) c2[(z * 2 + y) * 2 + x] = mean(4, 4 * x, 4 * y, 4 * z);
 }
 
 // --- Layout -------------------------------------------------------------------------------------
@@ -329,8 +277,6 @@ void fillBricks(BakedVolume& vol, const openvdb::FloatGrid& grid, const BrickBox
   const size_t texels = size_t(vol.atlasTexels.x) * vol.atlasTexels.y * vol.atlasTexels.z;
   if (vol.format == TexelFormat::Float32) vol.atlasF32.assign(texels, 0.0f);
   else vol.atlasF16.assign(texels, 0);
-  vol.coarse1.assign(size_t(vol.slotCount) * 64, 0.0f);
-  vol.coarse2.assign(size_t(vol.slotCount) * 8, 0.0f);
   vol.voxelMean.assign(size_t(vol.slotCount) * 512, 0.0f);
   vol.voxelResidual.assign(size_t(vol.slotCount) * 512, 0.0f);
   std::vector<float> brickMajorant(box.count(), 0.0f);
@@ -349,7 +295,7 @@ void fillBricks(BakedVolume& vol, const openvdb::FloatGrid& grid, const BrickBox
       brickMajorant[b] = res.majorant * kMajorantMargin;
       mine.maxAbsError = std::max(mine.maxAbsError, res.maxAbsError);
       mine.maxValue = std::max(mine.maxValue, res.maxValue);
-      writeCoarse(vol, s, w, opt.dilationFraction);
+      writeMeanField(vol, s, w);
     }
   });
   worst.combine_each([&](const SlotResult& r) {

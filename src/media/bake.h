@@ -24,18 +24,12 @@ constexpr int kBrickVoxels = 8;    // voxels per brick edge
 constexpr int kBrickTexels = 10;   // texels per brick edge in the atlas (8 + apron of 1 each side)
 constexpr int kBrickTexelCount = kBrickTexels * kBrickTexels * kBrickTexels;
 constexpr int kHierarchyFactor = 4;  // a hierarchy cell covers 4³ cells of the level below
-constexpr int kCoarse1Cells = 4;     // coarse level 1: 4³ cells of 2³ voxels per brick
-constexpr int kCoarse2Cells = 2;     // coarse level 2: 2³ cells of 4³ voxels per brick
 
 enum class TexelFormat : uint32_t { Float32 = 0, Float16 = 1 };  // R32F or R16F atlas
 const char* texelFormatName(TexelFormat format);                 // "float32", "float16"
 
 struct BakeOptions {
   TexelFormat format = TexelFormat::Float16;
-  // Dilation for the coarse mips: a zero voxel whose 26-neighbourhood holds a non-zero voxel gets
-  // this fraction of the neighbourhood's max (kept >= FLT_MIN, so it stays positive). 0 turns
-  // dilation off, which breaks the conservative guarantee (for tests only).
-  float dilationFraction = 0.25f;
   int maxAtlasSlotsPerAxis = 204;  // 204 * 10 = 2040 texels, under a 2048 3D-image limit
 };
 
@@ -80,14 +74,11 @@ struct BakedVolume {
   // and of the stored texels) times (1 + 2^-18), which bounds the float rounding of a lookup.
   std::vector<MaxLevel> maxLevels;
 
-  // Coarse conservative mips, per slot (slot 0 zeros), float32 so tiny positive values survive:
-  // coarse1[slot*64 + (z*4+y)*4+x] = mean of the dilated grid over voxels 8b + 2(x,y,z) + {0,1}³,
-  // coarse2[slot*8 + (z*2+y)*2+x]  = mean over voxels 8b + 4(x,y,z) + {0..3}³.
-  std::vector<float> coarse1;
-  std::vector<float> coarse2;
-  // Not conservative: ReSTIR's mean field on the GPU (restir/coarse.glsl), on single voxels:
-  // voxelMean[slot*512 + (z*8+y)*8+x] is the mean of the trilinear field over voxel [v, v+1]³
-  // (the mean of its 8 corner texels, which is also the field's value at the voxel's centre);
+  // ReSTIR's mean field on the GPU (restir/coarse.glsl), per slot (slot 0 zeros), float32, on
+  // single voxels: voxelMean[slot*512 + (z*8+y)*8+x] is the mean of the trilinear field over
+  // voxel [v, v+1]³ (the mean of its 8 corner texels, which is also the field's value at the
+  // voxel's centre), kept >= FLT_MIN where a corner is positive, so it is positive wherever the
+  // fine density is (candidates track it: their support);
   // voxelResidual bounds |d(p) - voxelMean| inside it: the largest corner deviation (a trilinear
   // field's extremes lie on the corners), widened by 2^-10 of each corner to cover float16
   // storage and interpolation rounding.
@@ -106,7 +97,7 @@ struct BakedVolume {
 };
 
 struct MemoryReport {
-  uint64_t atlasBytes = 0, indirectionBytes = 0, majorantBytes = 0, coarseBytes = 0;
+  uint64_t atlasBytes = 0, indirectionBytes = 0, majorantBytes = 0, coarseBytes = 0;  // coarse: the mean field
   uint64_t totalBytes = 0;
   double bytesPerActiveVoxel = 0;  // total / grid active voxels (0 for an empty grid)
 };
@@ -125,6 +116,6 @@ float atlasTexel(const BakedVolume& vol, glm::ivec3 texel);
 float sampleDensity(const BakedVolume& vol, glm::vec3 p);   // trilinear, 8 fetches, exact weights
 float sampleMajorant(const BakedVolume& vol, glm::vec3 p);  // = sampleMaxLevel(vol, 0, p)
 float sampleMaxLevel(const BakedVolume& vol, int level, glm::vec3 p);
-float sampleCoarse(const BakedVolume& vol, int level, glm::vec3 p);  // level 1 or 2, piecewise const
+float sampleVoxelMean(const BakedVolume& vol, glm::vec3 p);  // voxelMean of the voxel holding p
 
 }  // namespace plume

@@ -84,23 +84,13 @@ float sampleMaxLevel(const BakedVolume& vol, int level, glm::vec3 p) {
 
 float sampleMajorant(const BakedVolume& vol, glm::vec3 p) { return sampleMaxLevel(vol, 0, p); }
 
-// Piecewise-constant coarse density: the value of the level-1 (2³ voxels) or level-2 (4³ voxels)
-// cell containing floor(p), which is the cell containing p since cells start at even voxels.
-float sampleCoarse(const BakedVolume& vol, int level, glm::vec3 p) {
+float sampleVoxelMean(const BakedVolume& vol, glm::vec3 p) {
   const glm::ivec3 v = baseVoxel(p);
   const glm::ivec3 b = brickOfVoxel(v);
   const uint32_t slot = brickSlot(vol, b);
   if (slot == 0) return 0.0f;
-  const glm::ivec3 local = v - b * kBrickVoxels;  // 0..7
-  if (level == 1) {
-    const glm::ivec3 c = local / 2;
-    return vol.coarse1[size_t(slot) * 64 + size_t((c.z * kCoarse1Cells + c.y) * kCoarse1Cells + c.x)];
-  }
-  if (level == 2) {
-    const glm::ivec3 c = local / 4;
-    return vol.coarse2[size_t(slot) * 8 + size_t((c.z * kCoarse2Cells + c.y) * kCoarse2Cells + c.x)];
-  }
-  return 0.0f;
+  const glm::ivec3 c = v - b * kBrickVoxels;  // 0..7
+  return vol.voxelMean[size_t(slot) * 512 + size_t((c.z * kBrickVoxels + c.y) * kBrickVoxels + c.x)];
 }
 
 MemoryReport memoryReport(const BakedVolume& vol) {
@@ -108,7 +98,7 @@ MemoryReport memoryReport(const BakedVolume& vol) {
   m.atlasBytes = vol.atlasF32.size() * sizeof(float) + vol.atlasF16.size() * sizeof(uint16_t);
   m.indirectionBytes = vol.indirection.size() * sizeof(uint32_t);
   for (const auto& L : vol.maxLevels) m.majorantBytes += L.max.size() * sizeof(float);
-  m.coarseBytes = (vol.coarse1.size() + vol.coarse2.size() + vol.voxelMean.size() + vol.voxelResidual.size()) * sizeof(float);
+  m.coarseBytes = (vol.voxelMean.size() + vol.voxelResidual.size()) * sizeof(float);
   m.totalBytes = m.atlasBytes + m.indirectionBytes + m.majorantBytes + m.coarseBytes;
   if (vol.stats.activeVoxels) m.bytesPerActiveVoxel = double(m.totalBytes) / double(vol.stats.activeVoxels);
   return m;

@@ -63,7 +63,7 @@ GpuVolumeResources::GpuVolumeResources(gpu::Context& ctx, const BakedVolume& bak
     std::copy_n(&bake.voxelMean[slot * 512], 512, &coarse[slot * 1024]);
     std::copy_n(&bake.voxelResidual[slot * 512], 512, &coarse[slot * 1024 + 512]);
   }
-  coarse_ = gpu::Buffer(ctx, coarse.size() * 4, storage, "coarse mip");
+  coarse_ = gpu::Buffer(ctx, coarse.size() * 4, storage, "mean field");
   coarse_.upload(coarse.data(), coarse.size() * 4);
   counters_ = gpu::Buffer(ctx, 16, storage, "tracking counters");
   resetCounters();

@@ -1,6 +1,6 @@
 // The baked volume on the device (DESIGN §3): the brick atlas as a 3D texture (R16F or R32F),
-// the indirection and the majorant hierarchy as storage buffers, the coarse mips (kept for
-// ReSTIR), and the GpuVolume parameter block. Bindings 0..4 of every volume pass
+// the indirection and the majorant hierarchy as storage buffers, ReSTIR's voxel mean field, and
+// the GpuVolume parameter block. Bindings 0..4 of every volume pass
 // (shaders/volume/bindings.glsl).
 #pragma once
 
