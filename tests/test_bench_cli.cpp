@@ -94,11 +94,15 @@ TEST(BenchCli, WritesTableCsvAndPlotWithSaneNumbersAndCachesTheReference) {
   const size_t refs = countRefs(sceneDir / "bench_cache");
   EXPECT_GE(refs, 2u);  // static + moving poses
 
-  // Again: the cached references are reused. Then an edited scene gets new ones.
+  // Again, with ReSTIR retuned in the scene file: the cached references are reused (they do not
+  // depend on ReSTIR's settings). Then a scene edited where the image depends on it gets new ones.
+  std::string scene = readText(sceneDir / "smoke.json");
+  const size_t radius = scene.find("\"restir_radius\": 2");
+  ASSERT_NE(radius, std::string::npos);
+  std::ofstream(sceneDir / "smoke.json") << scene.replace(radius, 18, "\"restir_radius\": 3");
   r = test::runPlume(args);
   ASSERT_EQ(r.exitCode, 0) << r.output;
   EXPECT_EQ(countRefs(sceneDir / "bench_cache"), refs);
-  std::string scene = readText(sceneDir / "smoke.json");
   const size_t at = scene.find("\"density_scale\": 16.0");
   ASSERT_NE(at, std::string::npos);
   scene.replace(at, 21, "\"density_scale\": 12.0");

@@ -44,6 +44,8 @@ void addBenchCommand(CLI::App& app, Action& action) {
   cmd->add_option("--height", args->height, "image height (default 64)")->check(CLI::Range(1, 16384));
   cmd->add_option("--warmup", args->options.warmup, "frames before measuring")->check(CLI::Range(0, 1000));
   cmd->add_option("--measure", args->options.frames, "measured frames")->check(CLI::Range(1, 1000));
+  cmd->add_option("--frame", args->options.gridFrame, "animation frame whose grid is held still (default: the scene's first)")
+      ->check(CLI::Range(0, 1 << 20));
   cmd->add_option("--ref-spp", args->options.refSpp, "samples per pixel of the cached reference")->check(CLI::Range(16, 1 << 24));
   cmd->add_option("--pt-spp", args->options.ptSpp, "path tracer spp per frame (its curve)");
   cmd->add_option("--only", args->options.only, "run only the ReSTIR variants whose name contains one of these strings");

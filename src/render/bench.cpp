@@ -7,6 +7,7 @@
 #include "render/path_tracer.h"
 
 #include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -60,14 +61,27 @@ void makeFolder(const fs::path& dir) {
   if (ec) throw InputError("bench: cannot create " + dir.string() + ": " + ec.message());
 }
 
-// What the reference's pixels depend on besides its file name's fields: the scene file's text, the
-// grid file's size and time, the path length settings. An edited scene or a re-baked grid gets
-// a new reference, never a stale one.
-uint64_t referenceKey(const Scene& s, int frame) {
+// What the reference's pixels depend on besides its file name's fields: the scene file's content
+// less the render settings a reference does not use (mode, spp, seed, frames, the ReSTIR knobs),
+// the grid file's size and time, the path length settings. An edited scene or a re-baked grid gets
+// a new reference, never a stale one; tuning ReSTIR in the scene file keeps the cached one.
+uint64_t referenceKey(const Scene& s, int gridFrame) {
   std::ifstream in(s.path, std::ios::binary);
-  std::string key((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string key;
+  try {
+    nlohmann::json j = nlohmann::json::parse(in);
+    if (j.contains("render") && j["render"].is_object()) {
+      nlohmann::json& r = j["render"];
+      for (const char* unused : {"mode", "spp", "seed", "frames"}) r.erase(unused);
+      for (auto it = r.begin(); it != r.end();) it = it.key().rfind("restir_", 0) == 0 ? r.erase(it) : std::next(it);
+    }
+    key = j.dump();
+  } catch (const nlohmann::json::exception&) {
+    in.clear(), in.seekg(0);
+    key.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
   std::error_code ec;
-  const fs::path vdb = s.media.at(0).vdbPath(frame);
+  const fs::path vdb = s.media.at(0).vdbPath(gridFrame);
   const auto size = fs::file_size(vdb, ec);
   const auto time = fs::last_write_time(vdb, ec).time_since_epoch().count();
   key += strf("|%s|%llu|%lld|%d|%d", vdb.string().c_str(), (unsigned long long)size, (long long)time,
@@ -86,7 +100,7 @@ Image loadOrBuildReference(gpu::Context& ctx, gpu::ShaderCompiler& compiler, con
       (fs::path(s.dir) / "bench_cache" /
        strf("%s_ref_%s_f%d_%dx%d_spp%d_%.4f_%.4f_%.4f_%016llx.exr", stem.c_str(), tag.c_str(), frame, s.camera.width,
             s.camera.height, refSpp, p.position.x, p.position.y, p.position.z,
-            (unsigned long long)referenceKey(s, frame)))
+            (unsigned long long)referenceKey(s, s.camera.baseFrame)))  // the grid held still
           .string();
   if (fs::exists(path)) return readExr(path);
   logInfo(strf("bench: building the reference %s (%d spp)", path.c_str(), refSpp));
@@ -219,8 +233,9 @@ BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Sce
     });
     if (variants.empty()) throw InputError("bench: no ReSTIR variant matches --only");
   }
-  // The grid of the first frame, held still: the bench measures the estimators, not the animation.
-  const int first = scene.render.frameFirst;
+  // One frame's grid (the first of the scene's range unless chosen), held still: the bench measures
+  // the estimators, not the animation. Frame numbers count from it.
+  const int first = o.gridFrame >= 0 ? o.gridFrame : scene.render.frameFirst;
   const int last = first + o.warmup + o.frames - 1;
   const Medium& medium = scene.media.at(0);
   LoadedGrid grid = loadFloatGrid(medium.vdbPath(first), medium.densityGrid);
@@ -303,10 +318,10 @@ BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Sce
   }
 
   // Outputs.
-  std::string md = strf("Device: %s. Scene: %s, %dx%d, max_bounces %d. Warm-up %d frames, %d measured; "
-                        "medians. Reference: GPU path tracer, %d spp (own relMSE <= %.2g).\n\n",
+  std::string md = strf("Device: %s. Scene: %s, %dx%d, max_bounces %d, the grid of frame %d held still. Warm-up %d "
+                        "frames, %d measured; medians. Reference: GPU path tracer, %d spp (own relMSE <= %.2g).\n\n",
                         result.device.c_str(), scene.path.c_str(), scene.camera.width, scene.camera.height,
-                        scene.render.maxBounces, o.warmup, o.frames, o.refSpp, result.referenceRelMse);
+                        scene.render.maxBounces, first, o.warmup, o.frames, o.refSpp, result.referenceRelMse);
   md += "| camera | method | GPU ms/frame | relMSE | PT relMSE at equal time | gain vs PT | per-pass ms |\n";
   md += "|---|---|---|---|---|---|---|\n";
   std::string csv = "camera,method,frame_ms,relmse,pt_relmse_equal_time,gain\n";

@@ -18,6 +18,7 @@ namespace plume {
 struct BenchOptions {
   int warmup = 4;          // frames before measuring (temporal reuse reaches steady state)
   int frames = 6;          // measured frames
+  int gridFrame = -1;      // the animation frame whose grid is held still (-1: the scene's first)
   int refSpp = 2048;       // converged reference (GPU path tracer), >= 16x anything judged
   std::vector<int> ptSpp{1, 2, 4, 8, 16};
   std::vector<std::pair<std::string, RestirOptions>> variants;  // empty: a default list
