@@ -1,7 +1,8 @@
-// `plume render` as users and farms run it (issue 5, DESIGN §8): killed with SIGKILL mid-run and
-// rerun with --resume, no frame on disk is ever partial and the result equals an uninterrupted
-// run; same seed and device give the same pixels; a device that does not exist exits 3 naming
-// the devices there are; --preroll is accepted (a no-op for the path tracer).
+// `plume render` as users and farms run it (issue 5, DESIGN §8, docs/farm.md): killed with
+// SIGKILL mid-run and rerun with --resume, no frame on disk is ever partial and the result equals
+// an uninterrupted run; same seed and device give the same pixels; both estimators show the same
+// progress and write the full header; a device that does not exist exits 3 naming the devices
+// there are; --preroll is accepted (a no-op for the path tracer).
 #include "core/log.h"
 #include "gpu/context.h"
 #include "io/image.h"
@@ -32,6 +33,14 @@ std::string framePath(const std::string& dir, int frame) { return dir + "/f_" + 
 std::vector<std::string> renderArgs(const std::string& dir, const std::string& frames) {
   return {"render", kScene, "-o", dir + "/f_{frame:04}.exr", "--frames", frames, "--width", "80", "--height", "80",
           "--spp", "48", "--batch", "4", "--seed", "11", "-q"};
+}
+
+// Tiny frames for the tests that only look at which frames are rendered and at headers.
+std::vector<std::string> tinyArgs(const std::string& scene, const std::string& out, const std::string& frames,
+                                  const std::vector<std::string>& extra) {
+  std::vector<std::string> a = {"render", scene, "-o", out, "--frames", frames, "--height", "16", "--spp", "2"};
+  a.insert(a.end(), extra.begin(), extra.end());
+  return a;
 }
 
 }  // namespace
@@ -157,8 +166,8 @@ TEST(RenderCli, RestirPrerollWarmsWithoutWritingAndIsDeterministic) {
     return r.output;
   };
   const std::string out = run("a", "2");
-  EXPECT_NE(out.find("frame 3: pre-roll"), std::string::npos) << out;
-  EXPECT_NE(out.find("frame 4: pre-roll"), std::string::npos) << out;
+  EXPECT_NE(out.find("frame 3 (1/4): pre-roll (not written)"), std::string::npos) << out;
+  EXPECT_NE(out.find("frame 4 (2/4): pre-roll (not written)"), std::string::npos) << out;
   EXPECT_FALSE(std::filesystem::exists(framePath(dir + "/a", 3)));
   EXPECT_FALSE(std::filesystem::exists(framePath(dir + "/a", 4)));
   run("b", "2");
@@ -167,4 +176,47 @@ TEST(RenderCli, RestirPrerollWarmsWithoutWritingAndIsDeterministic) {
   EXPECT_EQ(a.meta["mode"], "restir");
   EXPECT_EQ(a.rgb, b.rgb) << "same seed, same pre-roll: same pixels";
   EXPECT_NE(a.rgb, c.rgb) << "the pre-roll must change the history the frame starts from";
+}
+
+TEST(RenderCli, RestirShowsTheSameProgressAndHeaderAsThePathTracer) {
+  const std::string dir = test::outputDir("render_cli_progress");
+  auto run = [&](const std::string& mode) {
+    test::RunResult r = test::runPlume(tinyArgs(kScene, dir + "/" + mode + "_{frame:04}.exr", "5-6",
+                                                {"--width", "16", "--mode", mode, "--preroll", "1"}));
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    return r.output;
+  };
+  const std::string pt = run("pt"), restir = run("restir");
+  EXPECT_NE(pt.find("frame 5 (1/2): " + dir + "/pt_0005.exr"), std::string::npos) << pt;
+  EXPECT_NE(pt.find("frame 6 (2/2): " + dir + "/pt_0006.exr"), std::string::npos) << pt;
+  EXPECT_NE(pt.find("rendered 2 frames in"), std::string::npos) << pt;
+  EXPECT_NE(restir.find("frame 4 (1/3): pre-roll (not written)"), std::string::npos) << restir;
+  EXPECT_NE(restir.find("frame 5 (2/3): " + dir + "/restir_0005.exr"), std::string::npos) << restir;
+  EXPECT_NE(restir.find("frame 6 (3/3): " + dir + "/restir_0006.exr"), std::string::npos) << restir;
+  EXPECT_NE(restir.find("rendered 2 frames and 1 pre-roll frame in"), std::string::npos) << restir;
+  for (const std::string& out : {pt, restir}) {
+    const size_t line = out.find("frame 6 (");
+    ASSERT_NE(line, std::string::npos) << out;
+    EXPECT_NE(out.substr(line, out.find('\n', line) - line).find("eta"), std::string::npos) << out;
+  }
+
+  const std::vector<const char*> common = {"version", "mode", "spp", "seed", "frame", "max_bounces", "device",
+                                           "texels", "wall_time_s", "tracking_truncated", "replaced_values",
+                                           "scene", "variant"};
+  Image p = readExr(dir + "/pt_0006.exr"), r = readExr(dir + "/restir_0006.exr");
+  for (const char* key : common) {
+    EXPECT_FALSE(p.meta[key].empty()) << "pt: " << key;
+    EXPECT_FALSE(r.meta[key].empty()) << "restir: " << key;
+  }
+  for (const char* key : {"batch", "pass_times_last_batch"}) EXPECT_FALSE(p.meta[key].empty()) << key;
+  for (const char* key : {"restir", "restir_iterations_averaged", "restir_history_from", "pass_times_last_iteration",
+                          "dropped_non_finite_reservoirs"}) {
+    EXPECT_FALSE(r.meta[key].empty()) << key;
+  }
+  EXPECT_EQ(r.meta["mode"], "restir");
+  EXPECT_EQ(r.meta["max_bounces"], "8");
+  EXPECT_EQ(r.meta["restir_history_from"], "4");
+  EXPECT_EQ(r.meta["restir_iterations_averaged"], "2");  // spp 2: none settles
+  EXPECT_EQ(r.meta["dropped_non_finite_reservoirs"], "0");
+  EXPECT_EQ(r.meta["restir"], "restir pairwise M4 k3 r2 R1 c20");
 }

@@ -14,7 +14,10 @@
 #include "scene/scene.h"
 
 #include <chrono>
+#include <functional>
+#include <map>
 #include <memory>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -47,70 +50,176 @@ std::pair<int, int> prerollRange(const Scene& scene, int preroll) {
   return {std::max(scene.camera.baseFrame, first - preroll), first - 1};
 }
 
-// ReSTIR frames: `spp` ReSTIR iterations per frame (one sample per pixel each), history kept
-// across iterations and frames; mean and variance of the iterations after the first quarter
-// (correlated by reuse, so the variance is a rough guide only).
-int runRestirRender(const RenderArgs& a, const Scene& scene) {
-  const RenderSettings& rs = scene.render;
-  if (rs.spp > int(Restir::kMaxIterations)) {
-    throw InputError(scene.path + strf(": render.spp: at most %u ReSTIR iterations per frame (got %d)",
-                                       Restir::kMaxIterations, rs.spp));
+// One estimator behind the frame loop (renderFrames): it renders a frame's samples over the
+// frame's volume and describes itself and its last frame for the EXR header and the log.
+class FrameEstimator {
+ public:
+  using SamplesDone = std::function<void(int)>;
+  virtual ~FrameEstimator() = default;
+  // Renders `frame` over `volume`; `previous` is the volume of the frame rendered just before in
+  // this run (null at the start and after a gap), for estimators that carry history.
+  // samplesDone(n) after every n samples per pixel (ReSTIR: iterations).
+  virtual void render(int frame, const GpuVolumeResources& volume, const GpuVolumeResources* previous,
+                      const SamplesDone& samplesDone) = 0;
+  virtual Image readImage() const = 0;
+  // The next frame starts without history (the frame before it was not rendered in this run).
+  virtual void forgetHistory() {}
+  // Header entries: variant, the estimator's settings, the last frame's timings and counters.
+  virtual void describe(std::map<std::string, std::string>& meta) const = 0;
+  // The last frame's timings and counters for its log line.
+  virtual std::string detail() const = 0;
+};
+
+// The path tracer: render.spp samples per pixel in dispatches of --batch (DESIGN §4.1).
+class PathTracerFrames final : public FrameEstimator {
+ public:
+  PathTracerFrames(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene, int batch)
+      : scene_(scene), tracer_(ctx, compiler, scene), batch_(batch) {}
+
+  void render(int frame, const GpuVolumeResources& volume, const GpuVolumeResources*,
+              const SamplesDone& samplesDone) override {
+    tracer_.setVolume(volume);
+    tracer_.beginFrame(frame);
+    for (int done = 0; done < scene_.render.spp;) {
+      const int n = std::min(batch_, scene_.render.spp - done);
+      tracer_.addSamples(n);
+      done += n;
+      samplesDone(n);
+    }
   }
-  a.outputs.check(rs);
-  BakeOptions bakeOptions;
-  bakeOptions.format = a.texels == "float32" ? TexelFormat::Float32 : TexelFormat::Float16;
-  gpu::Context ctx({a.device, false, !a.quiet});
-  gpu::ShaderCompiler compiler({}, gpu::ShaderCompiler::defaultCacheDir());
-  Restir restir(ctx, compiler, scene, restirOptionsOf(rs));
+  Image readImage() const override { return tracer_.readImage(); }
+  void describe(std::map<std::string, std::string>& meta) const override {
+    meta["variant"] = tracer_.variantName();
+    meta["batch"] = std::to_string(batch_);
+    meta["pass_times_last_batch"] = passTimesText(tracer_.lastPassTimes());
+  }
+  std::string detail() const override { return passTimesText(tracer_.lastPassTimes()); }
+
+ private:
+  const Scene& scene_;
+  PathTracer tracer_;
+  int batch_;
+};
+
+// ReSTIR: render.spp iterations per frame (one sample per pixel each), history kept across
+// iterations and frames; mean and variance of the iterations after the first quarter (correlated
+// by reuse, so the variance is a rough guide only).
+class RestirFrames final : public FrameEstimator {
+ public:
+  RestirFrames(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene)
+      : scene_(scene), restir_(ctx, compiler, scene, restirOptionsOf(scene.render)) {}
+
+  void render(int frame, const GpuVolumeResources& volume, const GpuVolumeResources* previous,
+              const SamplesDone& samplesDone) override {
+    if (!hasHistory_ || restir_.options().historyCap == 0) historyFrom_ = frame;
+    restir_.setVolumes(volume, previous ? *previous : volume);
+    // The first quarter of the iterations settle the reservoirs on the frame's grid and are not
+    // averaged (frame 12 of the bundled smoke, 12 iterations: relMSE 0.00095 averaging all,
+    // 0.00075 without the first 3; every iteration is unbiased, so any subset fixed in advance is).
+    const int spp = scene_.render.spp, settle = spp / 4;
+    averaged_ = spp - settle;
+    dropped_ = 0;
+    for (int i = 0; i < spp; ++i) {
+      if (i == 1) restir_.setVolumes(volume, volume);
+      restir_.render(frame, 0, uint32_t(i), i > settle);
+      dropped_ += restir_.lastDroppedCount();
+      samplesDone(1);
+    }
+    hasHistory_ = true;
+  }
+  Image readImage() const override { return restir_.readImage(); }
+  void forgetHistory() override {
+    restir_.resetHistory();
+    hasHistory_ = false;
+  }
+  void describe(std::map<std::string, std::string>& meta) const override {
+    meta["variant"] = restir_.features().name();
+    meta["restir"] = restir_.options().name();
+    meta["restir_iterations_averaged"] = std::to_string(averaged_);
+    // The first frame of the unbroken run of frames whose history this frame's reservoirs carry
+    // (the frame itself without temporal reuse): its pixels depend on where that run started.
+    meta["restir_history_from"] = std::to_string(historyFrom_);
+    meta["pass_times_last_iteration"] = passTimesText(restir_.lastPassTimes());
+    meta["dropped_non_finite_reservoirs"] = std::to_string(dropped_);
+  }
+  std::string detail() const override {
+    return strf("%s; dropped %u", passTimesText(restir_.lastPassTimes()).c_str(), dropped_);
+  }
+
+ private:
+  const Scene& scene_;
+  Restir restir_;
+  bool hasHistory_ = false;
+  int historyFrom_ = 0;
+  int averaged_ = 0;      // iterations in the frame's mean (the last ones, after those that settle)
+  uint32_t dropped_ = 0;  // unpacks whose non-finite weights were dropped, summed over the frame's iterations
+};
+
+// The frame loop of every estimator: --resume's skips, the pre-roll, one volume per frame (the
+// previous one kept for estimators that carry history), progress, EXR header, writes.
+int renderFrames(const RenderArgs& a, const Scene& scene, gpu::Context& ctx, FrameEstimator& estimator,
+                 const BakeOptions& bakeOptions) {
+  const RenderSettings& rs = scene.render;
   const Medium& medium = scene.media.at(0);
-  std::unique_ptr<GpuVolumeResources> prev;
-  // Pre-roll frames (before render.frames' first) warm the reservoirs and are not written. A frame
-  // skipped by --resume breaks the history: the next rendered frame starts cold.
-  const int warmFrom = prerollRange(scene, a.preroll).first;
-  for (int frame = warmFrom; frame <= rs.frameLast; ++frame) {
-    const bool warmOnly = frame < rs.frameFirst;
-    if (!warmOnly && a.outputs.skip(frame, rs)) {
-      restir.resetHistory();
-      prev.reset();
-      continue;
+  const bool history = carriesHistory(rs.mode);
+  struct Job {
+    int frame;
+    bool write;  // false: pre-roll
+  };
+  // Pre-roll frames (before render.frames' first) warm the history and are not written; dropped
+  // unless the first frame is rendered (a frame skipped by --resume breaks the history anyway).
+  const auto [warmFrom, warmTo] = prerollRange(scene, a.preroll);
+  std::vector<Job> jobs;
+  for (int frame = warmFrom; frame <= warmTo; ++frame) jobs.push_back({frame, false});
+  const size_t warm = jobs.size();
+  for (int frame = rs.frameFirst; frame <= rs.frameLast; ++frame) {
+    if (!a.outputs.skip(frame, rs)) jobs.push_back({frame, true});
+  }
+  if (jobs.size() == warm || jobs[warm].frame != rs.frameFirst) {
+    jobs.erase(jobs.begin(), jobs.begin() + ptrdiff_t(warm));
+  }
+  FrameProgress progress(int(jobs.size()), rs.spp, !a.quiet);
+  std::unique_ptr<GpuVolumeResources> previous;
+  for (size_t j = 0; j < jobs.size(); ++j) {
+    const int frame = jobs[j].frame;
+    if (j > 0 ? jobs[j - 1].frame != frame - 1 : frame > rs.frameFirst) {  // after frames --resume skipped
+      estimator.forgetHistory();
+      previous.reset();
+      if (history) logInfo(strf("frame %d: starts without history (frame %d was skipped)", frame, frame - 1));
     }
     const auto start = std::chrono::steady_clock::now();
+    progress.beginFrame(frame);
     LoadedGrid grid = loadFloatGrid(medium.vdbPath(frame), medium.densityGrid);
     auto volume = std::make_unique<GpuVolumeResources>(ctx, bakeVolume(grid, bakeOptions), medium.densityScale);
-    restir.setVolumes(*volume, prev ? *prev : *volume);
-    // render.spp ReSTIR iterations of the frame, averaged on the device; one read-back per frame.
-    // The first quarter settle the reservoirs on the frame's grid and are not averaged (frame 12
-    // of the bundled smoke, 12 iterations: relMSE 0.00095 averaging all, 0.00075 without the
-    // first 3; every iteration is unbiased, so any subset fixed in advance is).
-    const int settle = rs.spp / 4;
-    uint32_t dropped = 0;
-    for (int i = 0; i < rs.spp; ++i) {
-      if (i == 1) restir.setVolumes(*volume, *volume);
-      restir.render(frame, 0, uint32_t(i), i > settle);
-      dropped += restir.lastDroppedCount();
+    estimator.render(frame, *volume, previous.get(), [&](int n) { progress.samplesDone(n); });
+    const uint32_t truncated = volume->truncatedCount();
+    if (truncated > 0) {
+      logWarn(strf("frame %d: %u tracking loops hit the step cap and were truncated", frame, truncated));
     }
-    prev = std::move(volume);
-    if (warmOnly) {
-      if (!a.quiet) logInfo(strf("frame %d: pre-roll (not written)", frame));
+    previous = history ? std::move(volume) : nullptr;
+    if (!jobs[j].write) {
+      progress.frameWarmed(frame, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
       continue;
     }
-    Image sum = restir.readImage();
+    Image image = estimator.readImage();
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    sum.meta["version"] = PLUME_VERSION;
-    sum.meta["mode"] = rs.mode;
-    sum.meta["restir"] = restir.options().name();
-    sum.meta["spp"] = std::to_string(rs.spp);
-    sum.meta["seed"] = std::to_string(rs.seed);
-    sum.meta["frame"] = std::to_string(frame);
-    sum.meta["device"] = ctx.deviceName();
-    sum.meta["wall_time_s"] = strf("%.3f", seconds);
-    sum.meta["pass_times_last_iteration"] = passTimesText(restir.lastPassTimes());
-    sum.meta["dropped_non_finite_reservoirs"] = std::to_string(dropped);
-    sum.meta["scene"] = a.scene;
-    a.outputs.write(frame, sum);
-    if (!a.quiet) logInfo(strf("frame %d: %s  %.2fs (%s; dropped %u)", frame, a.outputs.exrPath(frame).c_str(), seconds,
-                               passTimesText(restir.lastPassTimes()).c_str(), dropped));
+    image.meta["version"] = PLUME_VERSION;
+    image.meta["mode"] = rs.mode;
+    image.meta["spp"] = std::to_string(rs.spp);
+    image.meta["seed"] = std::to_string(rs.seed);
+    image.meta["frame"] = std::to_string(frame);
+    image.meta["max_bounces"] = std::to_string(rs.maxBounces);
+    image.meta["device"] = ctx.deviceName();
+    image.meta["texels"] = texelFormatName(bakeOptions.format);
+    image.meta["wall_time_s"] = strf("%.3f", seconds);
+    image.meta["tracking_truncated"] = std::to_string(truncated);
+    image.meta["replaced_values"] = std::to_string(grid.replacedValues);
+    image.meta["scene"] = a.scene;
+    estimator.describe(image.meta);
+    a.outputs.write(frame, image);
+    progress.frameDone(frame, a.outputs.exrPath(frame), seconds, estimator.detail());
   }
+  progress.finish();
   return kExitOk;
 }
 
@@ -120,59 +229,23 @@ int runRender(const RenderArgs& a) {
   if (a.preroll > 0 && !carriesHistory(rs.mode)) {
     logInfo(strf("--preroll %d: no effect with mode %s (its frames are independent)", a.preroll, rs.mode.c_str()));
   }
-  // Mode dispatch: the one place that picks the estimator (today only the path tracer).
-  if (rs.mode != "pt") return runRestirRender(a, scene);  // restir, restir-biased (render/restir.h)
+  if (rs.mode != "pt" && rs.spp > int(Restir::kMaxIterations)) {
+    throw InputError(scene.path + strf(": render.spp: at most %u ReSTIR iterations per frame (got %d)",
+                                       Restir::kMaxIterations, rs.spp));
+  }
   a.outputs.check(rs);
   BakeOptions bakeOptions;
   bakeOptions.format = a.texels == "float32" ? TexelFormat::Float32 : TexelFormat::Float16;
-
   gpu::Context ctx({a.device, false, !a.quiet});
   gpu::ShaderCompiler compiler({}, gpu::ShaderCompiler::defaultCacheDir());
-  PathTracer tracer(ctx, compiler, scene);
-  const Medium& medium = scene.media.at(0);
-  std::vector<int> todo;  // frames not already complete (--resume)
-  for (int frame = rs.frameFirst; frame <= rs.frameLast; ++frame) {
-    if (!a.outputs.skip(frame, rs)) todo.push_back(frame);
+  // Mode dispatch: the one place that picks the estimator.
+  std::unique_ptr<FrameEstimator> estimator;
+  if (rs.mode == "pt") {
+    estimator = std::make_unique<PathTracerFrames>(ctx, compiler, scene, a.batch);
+  } else {
+    estimator = std::make_unique<RestirFrames>(ctx, compiler, scene);  // restir, restir-biased (render/restir.h)
   }
-  const int toRender = int(todo.size());
-  FrameProgress progress(toRender, rs.spp, !a.quiet);
-  for (int frame : todo) {
-    const auto start = std::chrono::steady_clock::now();
-    progress.beginFrame(frame);
-    LoadedGrid grid = loadFloatGrid(medium.vdbPath(frame), medium.densityGrid);
-    BakedVolume bake = bakeVolume(grid, bakeOptions);
-    GpuVolumeResources volume(ctx, bake, medium.densityScale);
-    tracer.setVolume(volume);
-    tracer.beginFrame(frame);
-    for (int done = 0; done < rs.spp;) {
-      const int n = std::min(a.batch, rs.spp - done);
-      tracer.addSamples(n);
-      done += n;
-      progress.samplesDone(n);
-    }
-    Image image = tracer.readImage();
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    const uint32_t truncated = volume.truncatedCount();
-    if (truncated > 0) logWarn(strf("frame %d: %u tracking loops hit the step cap and were truncated", frame, truncated));
-    image.meta["version"] = PLUME_VERSION;
-    image.meta["mode"] = rs.mode;
-    image.meta["spp"] = std::to_string(rs.spp);
-    image.meta["seed"] = std::to_string(rs.seed);
-    image.meta["frame"] = std::to_string(frame);
-    image.meta["max_bounces"] = std::to_string(rs.maxBounces);
-    image.meta["device"] = ctx.deviceName();
-    image.meta["variant"] = tracer.variantName();
-    image.meta["texels"] = texelFormatName(bake.format);
-    image.meta["wall_time_s"] = strf("%.3f", seconds);
-    image.meta["pass_times_last_batch"] = passTimesText(tracer.lastPassTimes());
-    image.meta["tracking_truncated"] = std::to_string(truncated);
-    image.meta["replaced_values"] = std::to_string(grid.replacedValues);
-    image.meta["scene"] = a.scene;
-    a.outputs.write(frame, image);
-    progress.frameDone(frame, a.outputs.exrPath(frame), seconds, passTimesText(tracer.lastPassTimes()));
-  }
-  progress.finish();
-  return kExitOk;
+  return renderFrames(a, scene, ctx, *estimator, bakeOptions);
 }
 
 }  // namespace

@@ -121,6 +121,15 @@ void FrameProgress::drawBar() {
 }
 
 void FrameProgress::frameDone(int frame, const std::string& path, double seconds, const std::string& detail) {
+  endFrame(frame, path, seconds, detail);
+}
+
+void FrameProgress::frameWarmed(int frame, double seconds) {
+  ++warmed_;
+  endFrame(frame, "pre-roll (not written)", seconds, "");
+}
+
+void FrameProgress::endFrame(int frame, const std::string& what, double seconds, const std::string& detail) {
   ++done_;
   sumSeconds_ += seconds;
   lastSeconds_ = seconds;
@@ -128,8 +137,8 @@ void FrameProgress::frameDone(int frame, const std::string& path, double seconds
   frameStart_ = std::chrono::steady_clock::now();
   if (!enabled_) return;
   if (tty_) std::fprintf(stderr, "\r\033[K");  // the log line replaces the bar, which is redrawn below it
-  logInfo(strf("frame %d (%d/%d): %s  %.2fs  eta %.1fs%s", frame, done_, total_, path.c_str(), seconds,
-               etaSeconds(), detail.empty() ? "" : ("  (" + detail + ")").c_str()));
+  logInfo(strf("frame %d (%d/%d): %s  %.2fs  eta %.1fs%s", frame, done_, total_, what.c_str(), seconds, etaSeconds(),
+               detail.empty() ? "" : ("  (" + detail + ")").c_str()));
   if (tty_ && done_ < total_) drawBar();
 }
 
@@ -137,7 +146,9 @@ void FrameProgress::finish() {
   if (!enabled_) return;
   const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   if (tty_) std::fprintf(stderr, "\r\033[K");
-  logInfo(strf("rendered %d frame%s in %.1fs%s", done_, done_ == 1 ? "" : "s", elapsed,
+  const int written = done_ - warmed_;
+  logInfo(strf("rendered %d frame%s%s in %.1fs%s", written, written == 1 ? "" : "s",
+               warmed_ > 0 ? strf(" and %d pre-roll frame%s", warmed_, warmed_ == 1 ? "" : "s").c_str() : "", elapsed,
                done_ > 0 ? strf(" (%.2fs/frame)", sumSeconds_ / done_).c_str() : ""));
 }
 
