@@ -1,8 +1,10 @@
 // `plume render` as users and farms run it (issue 5, DESIGN §8, docs/farm.md): killed with
 // SIGKILL mid-run and rerun with --resume, no frame on disk is ever partial and the result equals
-// an uninterrupted run; same seed and device give the same pixels; both estimators show the same
-// progress and write the full header; a device that does not exist exits 3 naming the devices
-// there are; --preroll is accepted (a no-op for the path tracer).
+// an uninterrupted run; --resume keeps a frame only when its header's render key matches (mode,
+// size, settings, scene) and says why it renders one again; same seed and device give the same
+// pixels; both estimators show the same progress and write the full header; a device that does
+// not exist exits 3 naming the devices there are; --preroll is accepted (a no-op for the path
+// tracer).
 #include "core/log.h"
 #include "gpu/context.h"
 #include "io/image.h"
@@ -14,6 +16,8 @@
 #include <csignal>
 #include <fcntl.h>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <thread>
@@ -41,6 +45,23 @@ std::vector<std::string> tinyArgs(const std::string& scene, const std::string& o
   std::vector<std::string> a = {"render", scene, "-o", out, "--frames", frames, "--height", "16", "--spp", "2"};
   a.insert(a.end(), extra.begin(), extra.end());
   return a;
+}
+
+// A copy of the bundled smoke scene in `dir` with another density scale (the VDB path made
+// absolute so it still resolves).
+std::string smokeSceneWithDensity(const std::string& dir, const std::string& name, const std::string& densityScale) {
+  std::ifstream in(kScene);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  auto replace = [&](const std::string& from, const std::string& to) {
+    const size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) text.replace(at, from.size(), to);
+  };
+  replace("\"smoke_{frame:04}.vdb\"", "\"" + test::sourcePath("volumes/smoke/smoke_{frame:04}.vdb") + "\"");
+  replace("\"density_scale\": 16.0", "\"density_scale\": " + densityScale);
+  const std::string path = dir + "/" + name;
+  std::ofstream(path) << text;
+  return path;
 }
 
 }  // namespace
@@ -178,6 +199,84 @@ TEST(RenderCli, RestirPrerollWarmsWithoutWritingAndIsDeterministic) {
   EXPECT_NE(a.rgb, c.rgb) << "the pre-roll must change the history the frame starts from";
 }
 
+TEST(RenderCli, ResumeRendersAFrameAgainWhenASettingItDependsOnChanged) {
+  const std::string dir = test::outputDir("render_cli_resume");
+  const std::string dense = smokeSceneWithDensity(dir, "dense.json", "16.0");
+  const std::string thin = smokeSceneWithDensity(dir, "thin.json", "12.0");
+  const std::string out = dir + "/f.exr";
+  struct Step {
+    std::string scene;
+    std::vector<std::string> args;
+    std::string expected;  // in the log: "is complete, skipped" or the setting that changed
+    bool newPixels = true;  // when rendered again (--batch changes the last bits at most)
+  };
+  // Each step resumes over the previous step's frame and changes one thing (the arguments are the
+  // full set each time). The bundled scene sets restir_radius 2 and max_bounces 8.
+  const std::vector<Step> steps = {
+      {dense, {"--width", "16"}, ""},
+      {dense, {"--width", "16"}, "is complete, skipped"},
+      {dense, {"--width", "16", "--restir-radius", "5"}, "is complete, skipped"},  // not the path tracer's
+      {dense, {"--width", "16", "--mode", "restir"}, "mode pt -> restir"},
+      {dense, {"--width", "16", "--mode", "restir", "--restir-radius", "5"}, "restir_radius 2 -> 5"},
+      {dense, {"--width", "16", "--mode", "restir", "--restir-radius", "5", "--max-bounces", "2"},
+       "max_bounces 8 -> 2"},
+      {dense, {"--width", "16", "--max-bounces", "2"}, "mode restir -> pt"},
+      {dense, {"--width", "12", "--max-bounces", "2"}, "camera.width 16 -> 12"},
+      {thin, {"--width", "12", "--max-bounces", "2"}, "media[0].density_scale 16 -> 12"},
+      {thin, {"--width", "12", "--max-bounces", "2", "--texels", "float32"}, "texels float16 -> float32"},
+      {thin, {"--width", "12", "--max-bounces", "2", "--texels", "float32", "--batch", "1"}, "batch 4 -> 1", false},
+  };
+  Image previous;
+  for (size_t i = 0; i < steps.size(); ++i) {
+    const Step& step = steps[i];
+    std::vector<std::string> args = tinyArgs(step.scene, out, "2", step.args);
+    args.push_back("--resume");
+    const auto before = fs::exists(out) ? fs::last_write_time(out) : fs::file_time_type{};
+    test::RunResult r = test::runPlume(args);
+    ASSERT_EQ(r.exitCode, 0) << "step " << i << ":\n" << r.output;
+    Image now = readExr(out);
+    const bool kept = step.expected == "is complete, skipped";
+    if (!step.expected.empty()) {
+      EXPECT_NE(r.output.find(step.expected), std::string::npos) << "step " << i << ":\n" << r.output;
+    }
+    if (kept) {
+      EXPECT_EQ(fs::last_write_time(out), before) << "step " << i << ": the frame must not be rewritten";
+      EXPECT_EQ(now.meta["render_key"], previous.meta["render_key"]) << "step " << i;
+    } else if (i > 0) {
+      EXPECT_NE(r.output.find("exists but it was rendered with other settings"), std::string::npos) << r.output;
+      EXPECT_NE(fs::last_write_time(out), before) << "step " << i << ": the frame must be rewritten";
+      EXPECT_NE(now.meta["render_key"], previous.meta["render_key"]) << "step " << i;
+      if (step.newPixels) {
+        EXPECT_TRUE(now.width != previous.width || now.rgb != previous.rgb) << "step " << i << ": same pixels";
+      }
+    }
+    EXPECT_NE(now.meta["render_key"].find("texels="), std::string::npos) << now.meta["render_key"];
+    previous = now;
+  }
+  EXPECT_EQ(previous.meta["mode"], "pt");
+  EXPECT_EQ(previous.meta["max_bounces"], "2");
+  EXPECT_EQ(previous.meta["texels"], "float32");
+  EXPECT_EQ(previous.meta["batch"], "1");
+  EXPECT_EQ(previous.width, 12);
+}
+
+TEST(RenderCli, ResumeRendersAgainAFrameWrittenWithoutARenderKey) {
+  const std::string dir = test::outputDir("render_cli_resume_old");
+  const std::string out = dir + "/f.exr";
+  auto args = tinyArgs(kScene, out, "2", {"--width", "16"});
+  ASSERT_EQ(test::runPlume(args).exitCode, 0);
+  Image old = readExr(out);
+  ASSERT_FALSE(old.meta["render_key"].empty());
+  old.meta.erase("render_key");  // as written by a plume from before render keys
+  writeExr(out, old);
+  args.push_back("--resume");
+  test::RunResult r = test::runPlume(args);
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_NE(r.output.find("no render_key"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("is complete, skipped"), std::string::npos) << r.output;
+  EXPECT_FALSE(readExr(out).meta["render_key"].empty()) << "the frame must have been written again";
+}
+
 TEST(RenderCli, RestirShowsTheSameProgressAndHeaderAsThePathTracer) {
   const std::string dir = test::outputDir("render_cli_progress");
   auto run = [&](const std::string& mode) {
@@ -202,7 +301,7 @@ TEST(RenderCli, RestirShowsTheSameProgressAndHeaderAsThePathTracer) {
 
   const std::vector<const char*> common = {"version", "mode", "spp", "seed", "frame", "max_bounces", "device",
                                            "texels", "wall_time_s", "tracking_truncated", "replaced_values",
-                                           "scene", "variant"};
+                                           "scene", "render_key", "variant"};
   Image p = readExr(dir + "/pt_0006.exr"), r = readExr(dir + "/restir_0006.exr");
   for (const char* key : common) {
     EXPECT_FALSE(p.meta[key].empty()) << "pt: " << key;

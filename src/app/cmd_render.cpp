@@ -51,7 +51,8 @@ std::pair<int, int> prerollRange(const Scene& scene, int preroll) {
 }
 
 // One estimator behind the frame loop (renderFrames): it renders a frame's samples over the
-// frame's volume and describes itself and its last frame for the EXR header and the log.
+// frame's volume, names the settings its pixels depend on, and describes itself and its last
+// frame for the EXR header and the log.
 class FrameEstimator {
  public:
   using SamplesDone = std::function<void(int)>;
@@ -64,6 +65,8 @@ class FrameEstimator {
   virtual Image readImage() const = 0;
   // The next frame starts without history (the frame before it was not rendered in this run).
   virtual void forgetHistory() {}
+  // The frame's render key (app/frame_output.h) as far as the estimator knows it.
+  virtual RenderKey key(int frame) const = 0;
   // Header entries: variant, the estimator's settings, the last frame's timings and counters.
   virtual void describe(std::map<std::string, std::string>& meta) const = 0;
   // The last frame's timings and counters for its log line.
@@ -88,6 +91,11 @@ class PathTracerFrames final : public FrameEstimator {
     }
   }
   Image readImage() const override { return tracer_.readImage(); }
+  RenderKey key(int frame) const override {
+    RenderKey key = sceneRenderKey(scene_, frame, [](const std::string& k) { return k.rfind("restir_", 0) != 0; });
+    key.add("batch", std::to_string(batch_));  // the running mean is merged per dispatch: the last bits differ
+    return key;
+  }
   void describe(std::map<std::string, std::string>& meta) const override {
     meta["variant"] = tracer_.variantName();
     meta["batch"] = std::to_string(batch_);
@@ -132,6 +140,9 @@ class RestirFrames final : public FrameEstimator {
     restir_.resetHistory();
     hasHistory_ = false;
   }
+  RenderKey key(int frame) const override {
+    return sceneRenderKey(scene_, frame, [](const std::string&) { return true; });
+  }
   void describe(std::map<std::string, std::string>& meta) const override {
     meta["variant"] = restir_.features().name();
     meta["restir"] = restir_.options().name();
@@ -165,15 +176,18 @@ int renderFrames(const RenderArgs& a, const Scene& scene, gpu::Context& ctx, Fra
   struct Job {
     int frame;
     bool write;  // false: pre-roll
+    RenderKey key;
   };
   // Pre-roll frames (before render.frames' first) warm the history and are not written; dropped
   // unless the first frame is rendered (a frame skipped by --resume breaks the history anyway).
   const auto [warmFrom, warmTo] = prerollRange(scene, a.preroll);
   std::vector<Job> jobs;
-  for (int frame = warmFrom; frame <= warmTo; ++frame) jobs.push_back({frame, false});
+  for (int frame = warmFrom; frame <= warmTo; ++frame) jobs.push_back({frame, false, {}});
   const size_t warm = jobs.size();
   for (int frame = rs.frameFirst; frame <= rs.frameLast; ++frame) {
-    if (!a.outputs.skip(frame, rs)) jobs.push_back({frame, true});
+    RenderKey key = estimator.key(frame);
+    key.add("texels", texelFormatName(bakeOptions.format));
+    if (!a.outputs.skip(frame, key)) jobs.push_back({frame, true, std::move(key)});
   }
   if (jobs.size() == warm || jobs[warm].frame != rs.frameFirst) {
     jobs.erase(jobs.begin(), jobs.begin() + ptrdiff_t(warm));
@@ -215,6 +229,7 @@ int renderFrames(const RenderArgs& a, const Scene& scene, gpu::Context& ctx, Fra
     image.meta["tracking_truncated"] = std::to_string(truncated);
     image.meta["replaced_values"] = std::to_string(grid.replacedValues);
     image.meta["scene"] = a.scene;
+    image.meta["render_key"] = jobs[j].key.text();
     estimator.describe(image.meta);
     a.outputs.write(frame, image);
     progress.frameDone(frame, a.outputs.exrPath(frame), seconds, estimator.detail());

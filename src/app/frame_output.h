@@ -2,6 +2,8 @@
 // writability checks, resume (a frame is complete when its EXR reads back with the same
 // settings in its header), EXR + optional PNG written atomically; and the progress display of a
 // frame sequence (bar with per-frame time and ETA on a terminal, one log line per frame otherwise).
+// `plume render` compares a full render key (every setting the pixels depend on); `plume
+// reference` still compares spp and seed only.
 #pragma once
 
 #include "app/settings_cli.h"
@@ -11,9 +13,34 @@
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace plume {
+
+// What a frame's pixels depend on besides the frame number, as ordered (name, value) pairs named
+// after the scene file's keys ("camera.width", "media[0].density_scale", "max_bounces"). Stored
+// in the EXR header as `render_key` ("name=value; name=value; ..."); --resume keeps a frame only
+// if the stored text equals this run's, so any setting added here re-renders older frames.
+struct RenderKey {
+  std::vector<std::pair<std::string, std::string>> entries;
+
+  void add(const std::string& name, const std::string& value) { entries.emplace_back(name, value); }
+  std::string text() const;
+  // The entries that differ from a stored text, e.g. "mode pt -> restir, camera.width 80 -> 64"
+  // ("(unset)" for a name only one side has); empty when the texts are equal.
+  std::string differences(const std::string& stored) const;
+};
+
+// The scene's part of a frame's key: the camera's size and its pose at `frame`, every medium
+// (this frame's VDB path relative to the scene's folder, grids, density scale, albedo, g,
+// emission), the lights and surfaces, and each render.* setting of the settings table except the
+// frame range, for which `uses(key)` holds (the table's new settings are included by default).
+// Not included: what only the history of a temporal estimator depends on (where a chunk starts,
+// --preroll), the device, plume's version, and the contents of the files named (VDB, OBJ, maps).
+RenderKey sceneRenderKey(const Scene& scene, int frame, const std::function<bool(const std::string&)>& uses);
 
 struct FrameOutputs {
   std::string pattern;  // -o value; {frame:04} replaced per frame
@@ -24,7 +51,12 @@ struct FrameOutputs {
   void check(const RenderSettings& rs) const;
   std::string exrPath(int frame) const;
   std::string pngPath(int frame) const;
-  // --resume and the frame's EXR is complete for these settings (mode, spp, seed).
+  // --resume and the frame's EXR (and PNG with --png) is complete and its header's render_key
+  // equals `key`. Otherwise logs why an existing frame is rendered again: other settings (which
+  // ones), no key (written by a plume from before render keys), unreadable, or no PNG.
+  bool skip(int frame, const RenderKey& key) const;
+  // --resume and the frame's EXR is complete with the same spp and seed (plume reference, whose
+  // EXRs carry no render key).
   bool skip(int frame, const RenderSettings& rs) const;
   // Atomic writes; first removes temporaries of this frame's files left by a killed run (a
   // process that no longer exists on this host, untouched for a minute).
