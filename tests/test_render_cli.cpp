@@ -2,9 +2,9 @@
 // SIGKILL mid-run and rerun with --resume, no frame on disk is ever partial and the result equals
 // an uninterrupted run; --resume keeps a frame only when its header's render key matches (mode,
 // size, settings, scene) and says why it renders one again; same seed and device give the same
-// pixels; both estimators show the same progress and write the full header; a device that does
-// not exist exits 3 naming the devices there are; --preroll is accepted (a no-op for the path
-// tracer).
+// pixels; ReSTIR frames depend on where their history starts and nothing else; both estimators
+// show the same progress and write the full header; a device that does not exist exits 3 naming
+// the devices there are; --preroll is accepted (a no-op for the path tracer).
 #include "core/log.h"
 #include "gpu/context.h"
 #include "io/image.h"
@@ -318,4 +318,28 @@ TEST(RenderCli, RestirShowsTheSameProgressAndHeaderAsThePathTracer) {
   EXPECT_EQ(r.meta["restir_iterations_averaged"], "2");  // spp 2: none settles
   EXPECT_EQ(r.meta["dropped_non_finite_reservoirs"], "0");
   EXPECT_EQ(r.meta["restir"], "restir pairwise M4 k3 r2 R1 c20");
+}
+
+// docs/farm.md: a ReSTIR frame is determined by the frame its history starts from (the chunk's
+// first frame less the pre-roll, or a gap left by --resume), not by how the range is split; with
+// restir_history_cap 0 frames are independent, as with pt.
+TEST(RenderCli, RestirFramesDependOnlyOnWhereTheirHistoryStarts) {
+  const std::string dir = test::outputDir("render_cli_restir_chunks");
+  auto run = [&](const std::string& sub, const std::string& frames, std::vector<std::string> extra) {
+    extra.insert(extra.end(), {"--width", "16", "--mode", "restir", "-q"});
+    test::RunResult r = test::runPlume(tinyArgs(kScene, dir + "/" + sub + "/f_{frame:04}.exr", frames, extra));
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    return readExr(framePath(dir + "/" + sub, 3));
+  };
+  for (const char* sub : {"long", "chunk", "cold", "long0", "chunk0"}) fs::create_directories(dir + "/" + sub);
+  Image whole = run("long", "1-3", {}), chunk = run("chunk", "3", {"--preroll", "2"}), cold = run("cold", "3", {});
+  EXPECT_EQ(whole.meta["restir_history_from"], "1");
+  EXPECT_EQ(chunk.meta["restir_history_from"], "1");
+  EXPECT_EQ(cold.meta["restir_history_from"], "3");
+  EXPECT_EQ(whole.rgb, chunk.rgb) << "a pre-roll back to the run's first frame reproduces the long run";
+  EXPECT_NE(whole.rgb, cold.rgb) << "a chunk starting cold has another history";
+  Image whole0 = run("long0", "1-3", {"--restir-history-cap", "0"});
+  Image chunk0 = run("chunk0", "3", {"--restir-history-cap", "0"});
+  EXPECT_EQ(chunk0.meta["restir_history_from"], "3");
+  EXPECT_EQ(whole0.rgb, chunk0.rgb) << "without temporal reuse ReSTIR frames are independent";
 }
