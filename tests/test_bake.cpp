@@ -306,6 +306,25 @@ TEST(Bake, AtlasLayoutHoldsEverySlot) {
   EXPECT_TRUE(glm::all(glm::lessThanEqual(last + kBrickTexels, vol.atlasTexels)));
 }
 
+// A bake without ReSTIR's mean field (path tracing) holds the same texels and majorants, and no
+// memory for the field.
+TEST(Bake, WithoutTheMeanFieldTheRestIsTheSame) {
+  BakeOptions without;
+  without.meanField = false;
+  const BakedVolume a = bakeVolume(wrap(makeNoisyGrid()));
+  const BakedVolume b = bakeVolume(wrap(makeNoisyGrid()), without);
+  EXPECT_FALSE(a.voxelMean.empty());
+  EXPECT_TRUE(b.voxelMean.empty() && b.voxelResidual.empty());
+  EXPECT_EQ(a.atlasF16, b.atlasF16);
+  EXPECT_EQ(a.indirection, b.indirection);
+  ASSERT_EQ(a.maxLevels.size(), b.maxLevels.size());
+  for (size_t k = 0; k < a.maxLevels.size(); ++k) EXPECT_EQ(a.maxLevels[k].max, b.maxLevels[k].max) << k;
+  const MemoryReport ma = memoryReport(a), mb = memoryReport(b);
+  EXPECT_EQ(mb.coarseBytes, 0u);
+  EXPECT_EQ(ma.totalBytes - ma.coarseBytes, mb.totalBytes);
+  EXPECT_EQ(ma.coarseBytes, uint64_t(a.slotCount) * 512 * 2 * sizeof(float));
+}
+
 // ReSTIR's mean field (bake.h voxelMean, voxelResidual): the mean of a trilinear field over a
 // voxel is its value at the voxel's centre (multilinear, symmetric interval); the residual bound
 // holds at random points and is tight (the largest deviation found comes within 40% of it: the
@@ -345,7 +364,9 @@ TEST(Bake, VoxelMeanAndResidualBoundDescribeTheTrilinearFieldAndCoverItsSupport)
             for (int k = 0; k < 32; ++k) {
               const double d = sampleDensity(vol, lo + glm::vec3(u(rng), u(rng), u(rng)));
               worst = std::max(worst, std::abs(d - mean));
-              if (d > 0) ASSERT_GT(mean, 0.0) << "brick " << bx << "," << by << "," << bz << " voxel " << c;
+              if (d > 0) {
+                ASSERT_GT(mean, 0.0) << "brick " << bx << "," << by << "," << bz << " voxel " << c;
+              }
             }
             ASSERT_LE(worst, bound) << "brick " << bx << "," << by << "," << bz << " voxel " << c;
             if (bound > 0) ++cells, tight += worst > 0.6 * bound;

@@ -61,7 +61,7 @@ void printBake(const BakedVolume& v, int runs) {
   std::printf("\n  storage error   max |stored - float| = %.3g (max value %.3g)\n", v.stats.maxAbsError,
               v.stats.maxValue);
   std::printf("  memory          %.1f KiB total: atlas %.1f, indirection %.1f, majorants %.1f, "
-              "coarse %.1f KiB; %.2f bytes per active voxel\n",
+              "ReSTIR's mean field %.1f KiB (path-traced renders leave it out); %.2f bytes per active voxel\n",
               m.totalBytes / 1024.0, m.atlasBytes / 1024.0, m.indirectionBytes / 1024.0,
               m.majorantBytes / 1024.0, m.coarseBytes / 1024.0, m.bytesPerActiveVoxel);
 }

@@ -251,6 +251,7 @@ int runRender(const RenderArgs& a) {
   a.outputs.check(rs);
   BakeOptions bakeOptions;
   bakeOptions.format = a.texels == "float32" ? TexelFormat::Float32 : TexelFormat::Float16;
+  bakeOptions.meanField = rs.mode != "pt";  // only ReSTIR reads it
   gpu::Context ctx({a.device, false, !a.quiet});
   gpu::ShaderCompiler compiler({}, gpu::ShaderCompiler::defaultCacheDir());
   // Mode dispatch: the one place that picks the estimator.

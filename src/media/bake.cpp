@@ -277,8 +277,10 @@ void fillBricks(BakedVolume& vol, const openvdb::FloatGrid& grid, const BrickBox
   const size_t texels = size_t(vol.atlasTexels.x) * vol.atlasTexels.y * vol.atlasTexels.z;
   if (vol.format == TexelFormat::Float32) vol.atlasF32.assign(texels, 0.0f);
   else vol.atlasF16.assign(texels, 0);
-  vol.voxelMean.assign(size_t(vol.slotCount) * 512, 0.0f);
-  vol.voxelResidual.assign(size_t(vol.slotCount) * 512, 0.0f);
+  if (opt.meanField) {
+    vol.voxelMean.assign(size_t(vol.slotCount) * 512, 0.0f);
+    vol.voxelResidual.assign(size_t(vol.slotCount) * 512, 0.0f);
+  }
   std::vector<float> brickMajorant(box.count(), 0.0f);
   for (const auto& [b, s] : slots) vol.indirection[b] = s;
 
@@ -295,7 +297,7 @@ void fillBricks(BakedVolume& vol, const openvdb::FloatGrid& grid, const BrickBox
       brickMajorant[b] = res.majorant * kMajorantMargin;
       mine.maxAbsError = std::max(mine.maxAbsError, res.maxAbsError);
       mine.maxValue = std::max(mine.maxValue, res.maxValue);
-      writeMeanField(vol, s, w);
+      if (opt.meanField) writeMeanField(vol, s, w);
     }
   });
   worst.combine_each([&](const SlotResult& r) {

@@ -31,6 +31,8 @@ const char* texelFormatName(TexelFormat format);                 // "float32", "
 struct BakeOptions {
   TexelFormat format = TexelFormat::Float16;
   int maxAtlasSlotsPerAxis = 204;  // 204 * 10 = 2040 texels, under a 2048 3D-image limit
+  bool meanField = true;  // ReSTIR's voxel mean field (8 bytes per voxel of every brick); the path
+                          // tracer does not read it, so a path-traced render leaves it out
 };
 
 // One level of the max hierarchy used for empty-space skipping (DDA). Level 0 is the per-brick
@@ -82,6 +84,7 @@ struct BakedVolume {
   // voxelResidual bounds |d(p) - voxelMean| inside it: the largest corner deviation (a trilinear
   // field's extremes lie on the corners), widened by 2^-10 of each corner to cover float16
   // storage and interpolation rounding.
+  // Both empty when baked without it (BakeOptions::meanField).
   std::vector<float> voxelMean;
   std::vector<float> voxelResidual;
 

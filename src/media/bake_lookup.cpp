@@ -2,6 +2,8 @@
 // Deliberately free of OpenVDB: this is the arithmetic the GPU performs, texel for texel.
 #include "media/bake.h"
 
+#include "core/error.h"
+
 #include <cmath>
 #include <cstring>
 
@@ -85,6 +87,7 @@ float sampleMaxLevel(const BakedVolume& vol, int level, glm::vec3 p) {
 float sampleMajorant(const BakedVolume& vol, glm::vec3 p) { return sampleMaxLevel(vol, 0, p); }
 
 float sampleVoxelMean(const BakedVolume& vol, glm::vec3 p) {
+  PLUME_CHECK(!vol.voxelMean.empty());  // baked with BakeOptions::meanField
   const glm::ivec3 v = baseVoxel(p);
   const glm::ivec3 b = brickOfVoxel(v);
   const uint32_t slot = brickSlot(vol, b);

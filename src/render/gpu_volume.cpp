@@ -63,6 +63,9 @@ GpuVolumeResources::GpuVolumeResources(gpu::Context& ctx, const BakedVolume& bak
     std::copy_n(&bake.voxelMean[slot * 512], 512, &coarse[slot * 1024]);
     std::copy_n(&bake.voxelResidual[slot * 512], 512, &coarse[slot * 1024 + 512]);
   }
+  // Baked without it (a path-traced render): a placeholder, so that binding sets stay valid.
+  hasMeanField_ = !coarse.empty();
+  if (coarse.empty()) coarse.assign(4, 0.0f);
   coarse_ = gpu::Buffer(ctx, coarse.size() * 4, storage, "mean field");
   coarse_.upload(coarse.data(), coarse.size() * 4);
   counters_ = gpu::Buffer(ctx, 16, storage, "tracking counters");

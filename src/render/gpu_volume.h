@@ -26,6 +26,7 @@ class GpuVolumeResources {
                       uint32_t coarse) const;
   const shared::GpuVolume& params() const { return params_; }
   uint64_t deviceBytes() const { return bytes_; }
+  bool hasMeanField() const { return hasMeanField_; }  // ReSTIR needs it (BakeOptions::meanField)
   // Unique per constructed volume in this process (never reused), so a renderer can tell that
   // the volume it rendered last frame is the one it is given now.
   uint64_t serial() const { return serial_; }
@@ -36,6 +37,7 @@ class GpuVolumeResources {
 
  private:
   shared::GpuVolume params_{};
+  bool hasMeanField_ = false;
   gpu::Buffer paramBuffer_;
   gpu::Image3D atlas_;
   gpu::Buffer indirection_;

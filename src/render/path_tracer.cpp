@@ -22,7 +22,9 @@ gpu::ShaderDefines FeatureSet::defines() const {
 std::string FeatureSet::name() const {
   std::string n;
   auto add = [&](bool on, const char* s) {
-    if (on) n += (n.empty() ? "" : "+") + std::string(s);
+    if (!on) return;
+    if (!n.empty()) n += '+';
+    n += s;
   };
   add(sun, "sun");
   add(point, "point");

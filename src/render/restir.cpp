@@ -142,6 +142,7 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
 }
 
 void Restir::setVolumes(const GpuVolumeResources& current, const GpuVolumeResources& previous) {
+  PLUME_CHECK(current.hasMeanField() && previous.hasMeanField());  // baked with BakeOptions::meanField
   for (gpu::ComputePass* p : {candidates_.get(), temporal_.get(), spatial_.get(), shade_.get()}) {
     current.bind(p->set);
     current.bindCoarse(p->set, 8);
