@@ -13,11 +13,11 @@
 layout(std430, binding = 5) readonly buffer FrameBuffer { GpuFrame frame; };
 layout(std430, binding = 6) readonly buffer LightBuffer { GpuLight lights[]; };
 layout(std430, binding = 7) readonly buffer RestirParamBuffer { RestirParams rsp; };
-layout(std430, binding = 8) readonly buffer CoarseBuffer { float volCoarse[]; };  // voxel means, residuals: 1024 per slot
+layout(std430, binding = 8) readonly buffer CoarseBuffer { uint volCoarse[]; };  // per voxel: float16 mean, residual (512 per slot)
 layout(std430, binding = 9) readonly buffer PrevVolumeBuffer { GpuVolume prevVol; };
 layout(binding = 10) uniform sampler3D prevAtlas;
 layout(std430, binding = 11) readonly buffer PrevIndirectionBuffer { uint prevIndirection[]; };
-layout(std430, binding = 12) readonly buffer PrevCoarseBuffer { float prevCoarse[]; };
+layout(std430, binding = 12) readonly buffer PrevCoarseBuffer { uint prevCoarse[]; };
 // Reservoir sets: [set * pixels + pixel].
 layout(std430, binding = 13) buffer ReservoirBuffer { RsPacked rsReservoirs[]; };
 layout(std430, binding = 14) buffer PathBuffer { RsPathHead rsPaths[]; };

@@ -97,7 +97,7 @@ bool rs_walk_start(uint v, vec3 o, vec3 d, float tMax, out RsWalk w) {
 }
 
 // The next voxel segment [a, b) in an occupied brick and the voxel's index i in the field buffer
-// (its mean at i, its residual bound at i + 512).
+// (its mean and residual bound, two float16: rs_mean_field).
 bool rs_walk_next(inout RsWalk w, out float a, out float b, out uint i) {
   a = 0.0f;
   b = 0.0f;
@@ -119,13 +119,15 @@ bool rs_walk_next(inout RsWalk w, out float a, out float b, out uint i) {
     if (slot == 0u) continue;
     ivec3 slots = w.v == 0u ? vol.atlasSlots.xyz : prevVol.atlasSlots.xyz;
     uint index = (slot & 1023u) + uint(slots.x) * (((slot >> 10u) & 1023u) + uint(slots.y) * (slot >> 20u));
-    w.base = index * 1024u;
+    w.base = index * 512u;
     w.inBrick = dda_init(w.voxels, w.o, w.d, ba, bb, vec3((w.origin + brick) * 8), 1.0f, ivec3(8));
   }
   return false;
 }
 
-float rs_walk_value(RsWalk w, uint i) { return w.v == 0u ? volCoarse[i] : prevCoarse[i]; }
+// (mean, residual bound) of voxel i of the current volume's field (bake.h packedMeanField).
+vec2 rs_mean_field(uint i) { return unpackHalf2x16(volCoarse[i]); }
+float rs_walk_value(RsWalk w, uint i) { return unpackHalf2x16(w.v == 0u ? volCoarse[i] : prevCoarse[i]).x; }
 
 // Optical depth of the coarse trilinear-mean field over (0, tMax) along a world ray
 // (deterministic; approximates the fine optical depth, not a bound).
@@ -168,7 +170,7 @@ bool rs_coarse_sample(vec3 xWorld, vec3 wWorld, float tMax, float u, out float t
   float b;
   uint i;
   while (rs_walk_next(w, a, b, i)) {
-    float sigma = scale * volCoarse[i];
+    float sigma = scale * rs_mean_field(i).x;
     float dtau = sigma * (b - a);
     if (sigma > 0.0f && dtau >= left) {
       t = a + left / sigma;
@@ -204,9 +206,10 @@ float rs_residual_tr(vec3 xWorld, vec3 wWorld, float tMax, inout RngState rng) {
   float b;
   uint i;
   while (prod != 0.0f && rs_walk_next(w, a, b, i)) {
-    float mean = scale * volCoarse[i];
+    vec2 field = rs_mean_field(i);
+    float mean = scale * field.x;
     tau += mean * (b - a);
-    float mu = PLUME_RS_RESIDUAL_SCALE * scale * volCoarse[i + 512u];
+    float mu = PLUME_RS_RESIDUAL_SCALE * scale * field.y;
     if (!(mu > 0.0f)) continue;
     float t = a;
     for (;;) {

@@ -33,6 +33,15 @@ using LeafT = FloatTree::LeafNodeType;
 using Window = std::array<float, kBrickTexelCount>;  // x fastest: [(z*10 + y)*10 + x]
 
 constexpr float kHalfMax = 65504.0f;
+constexpr float kHalfMinNormal = 0x1p-14f;
+
+// The least float16 value >= v (v >= 0), capped at kHalfMax.
+float halfAtLeast(double v) {
+  if (v >= double(kHalfMax)) return kHalfMax;
+  openvdb::math::half h{float(v)};  // nearest
+  if (double(float(h)) < v) h.setBits(uint16_t(h.bits() + 1));
+  return float(h);
+}
 // The lookup's float weights sum to 1 only within a few ulp, so a lookup whose 8 texels all
 // equal M can return M(1 + ~10 * 2^-24). Majorants are raised by 2^-18 (64 ulp) to bound it.
 constexpr float kMajorantMargin = 1.0f + 1.0f / 262144.0f;
@@ -185,11 +194,12 @@ void writeMeanField(BakedVolume& vol, uint32_t slot, const Window& w) {
           corner[k] = w[windowIndex(x + 1 + (k & 1), y + 1 + ((k >> 1) & 1), z + 1 + (k >> 2))];
           sum += corner[k];
         }
-        const double mean = sum / 8.0;
+        float mean = 0.0f;
+        if (sum > 0.0) mean = std::max(float(openvdb::math::half(float(std::min(sum / 8.0, double(kHalfMax))))), kHalfMinNormal);
         double dev = 0.0;
         for (double c : corner) dev = std::max(dev, std::abs(c - mean) + std::abs(c) * 0x1p-10);
-        vm[(z * 8 + y) * 8 + x] = sum > 0.0 ? std::max(float(mean), std::numeric_limits<float>::min()) : 0.0f;
-        vr[(z * 8 + y) * 8 + x] = float(dev);
+        vm[(z * 8 + y) * 8 + x] = mean;
+        vr[(z * 8 + y) * 8 + x] = halfAtLeast(dev);
       }
 }
 
@@ -341,6 +351,15 @@ BakedVolume bakeVolume(const LoadedGrid& loaded, const BakeOptions& opt) {
   fillBricks(vol, grid, box, candidateBricks(core, box), core, opt, where);
   vol.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return vol;
+}
+
+std::vector<uint32_t> packedMeanField(const BakedVolume& vol) {
+  std::vector<uint32_t> out(vol.voxelMean.size());
+  for (size_t i = 0; i < out.size(); ++i) {  // the values are float16 already: exact conversions
+    out[i] = uint32_t(openvdb::math::half(vol.voxelMean[i]).bits()) |
+             uint32_t(openvdb::math::half(vol.voxelResidual[i]).bits()) << 16;
+  }
+  return out;
 }
 
 }  // namespace plume

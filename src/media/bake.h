@@ -76,14 +76,16 @@ struct BakedVolume {
   // and of the stored texels) times (1 + 2^-18), which bounds the float rounding of a lookup.
   std::vector<MaxLevel> maxLevels;
 
-  // ReSTIR's mean field on the GPU (restir/coarse.glsl), per slot (slot 0 zeros), float32, on
-  // single voxels: voxelMean[slot*512 + (z*8+y)*8+x] is the mean of the trilinear field over
-  // voxel [v, v+1]³ (the mean of its 8 corner texels, which is also the field's value at the
-  // voxel's centre), kept >= FLT_MIN where a corner is positive, so it is positive wherever the
-  // fine density is (candidates track it: their support);
-  // voxelResidual bounds |d(p) - voxelMean| inside it: the largest corner deviation (a trilinear
-  // field's extremes lie on the corners), widened by 2^-10 of each corner to cover float16
-  // storage and interpolation rounding.
+  // ReSTIR's mean field on the GPU (restir/coarse.glsl), per slot (slot 0 zeros), on single
+  // voxels, stored as two float16 per voxel (packedMeanField); these are the values the GPU
+  // reads: voxelMean[slot*512 + (z*8+y)*8+x] is the mean of the trilinear field over voxel
+  // [v, v+1]³ (the mean of its 8 corner texels, also the field's value at the voxel's centre),
+  // rounded to float16 and kept >= 2^-14 (float16's least normal, so no device flushes it to 0)
+  // where a corner is positive: it is positive wherever the fine density is (candidates track
+  // it: their support); voxelResidual bounds |d(p) - voxelMean| inside it: the largest corner
+  // deviation from the stored mean (a trilinear field's extremes lie on the corners), widened by
+  // 2^-10 of each corner to cover float16 texels and interpolation rounding, rounded up to
+  // float16 (capped at 65504: beyond, residual ratio tracking stays unbiased, only noisier).
   // Both empty when baked without it (BakeOptions::meanField).
   std::vector<float> voxelMean;
   std::vector<float> voxelResidual;
@@ -120,5 +122,8 @@ float sampleDensity(const BakedVolume& vol, glm::vec3 p);   // trilinear, 8 fetc
 float sampleMajorant(const BakedVolume& vol, glm::vec3 p);  // = sampleMaxLevel(vol, 0, p)
 float sampleMaxLevel(const BakedVolume& vol, int level, glm::vec3 p);
 float sampleVoxelMean(const BakedVolume& vol, glm::vec3 p);  // voxelMean of the voxel holding p
+// The mean field as the GPU buffer holds it: per voxel one word, the float16 mean in the low
+// half and the float16 residual bound in the high half (GLSL unpackHalf2x16 .x, .y).
+std::vector<uint32_t> packedMeanField(const BakedVolume& vol);
 
 }  // namespace plume

@@ -101,7 +101,7 @@ MemoryReport memoryReport(const BakedVolume& vol) {
   m.atlasBytes = vol.atlasF32.size() * sizeof(float) + vol.atlasF16.size() * sizeof(uint16_t);
   m.indirectionBytes = vol.indirection.size() * sizeof(uint32_t);
   for (const auto& L : vol.maxLevels) m.majorantBytes += L.max.size() * sizeof(float);
-  m.coarseBytes = (vol.voxelMean.size() + vol.voxelResidual.size()) * sizeof(float);
+  m.coarseBytes = vol.voxelMean.size() * sizeof(uint32_t);  // two float16 per voxel (packedMeanField)
   m.totalBytes = m.atlasBytes + m.indirectionBytes + m.majorantBytes + m.coarseBytes;
   if (vol.stats.activeVoxels) m.bytesPerActiveVoxel = double(m.totalBytes) / double(vol.stats.activeVoxels);
   return m;

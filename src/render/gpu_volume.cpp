@@ -56,16 +56,12 @@ GpuVolumeResources::GpuVolumeResources(gpu::Context& ctx, const BakedVolume& bak
   indirection_.upload(packed.data(), packed.size() * 4);
   majorants_ = gpu::Buffer(ctx, majorants.size() * 4, storage, "majorant hierarchy");
   majorants_.upload(majorants.data(), majorants.size() * 4);
-  // Per atlas slot 1024 floats: the trilinear field's voxel means (512) and their residual
-  // bounds (512) (restir/coarse.glsl).
-  std::vector<float> coarse(bake.voxelMean.size() * 2);
-  for (size_t slot = 0; slot < bake.voxelMean.size() / 512; ++slot) {
-    std::copy_n(&bake.voxelMean[slot * 512], 512, &coarse[slot * 1024]);
-    std::copy_n(&bake.voxelResidual[slot * 512], 512, &coarse[slot * 1024 + 512]);
-  }
+  // Per atlas slot 512 words: each voxel's mean and residual bound as two float16
+  // (bake.h packedMeanField; restir/coarse.glsl).
+  std::vector<uint32_t> coarse = packedMeanField(bake);
   // Baked without it (a path-traced render): a placeholder, so that binding sets stay valid.
   hasMeanField_ = !coarse.empty();
-  if (coarse.empty()) coarse.assign(4, 0.0f);
+  if (coarse.empty()) coarse.assign(4, 0u);
   coarse_ = gpu::Buffer(ctx, coarse.size() * 4, storage, "mean field");
   coarse_.upload(coarse.data(), coarse.size() * 4);
   counters_ = gpu::Buffer(ctx, 16, storage, "tracking counters");

@@ -17,9 +17,9 @@ class GpuVolumeResources {
 
   // Binds params (0), atlas (1), indirection (2), majorants (3), counters (4).
   void bind(gpu::DescriptorSet& set) const;
-  // Binds ReSTIR's mean field at `coarse` (binding 8): 1024 floats per atlas slot (slot index
-  // x + X * (y + Y * z) of the packed slot coordinates), the 512 voxel means then their 512
-  // residual bounds (bake.h voxelMean, voxelResidual).
+  // Binds ReSTIR's mean field at `coarse` (binding 8): 512 words per atlas slot (slot index
+  // x + X * (y + Y * z) of the packed slot coordinates), each voxel's mean and residual bound as
+  // two float16 (bake.h packedMeanField).
   void bindCoarse(gpu::DescriptorSet& set, uint32_t coarse) const;
   // Binds this volume as ReSTIR's previous-frame volume (bindings 9..12 of restir/bindings.glsl).
   void bindAsPrevious(gpu::DescriptorSet& set, uint32_t params, uint32_t atlas, uint32_t indirection,
