@@ -1,20 +1,26 @@
 // `plume reference` end to end on the bundled smoke: a 128² frame at 256 spp completes, its
 // variance image agrees with the spread between two independent seeds, the same seed gives the
-// same pixels, and the header carries the run's metadata.
+// same pixels, and the header carries the run's metadata; --resume keeps a frame only when its
+// header's render key matches (the settings the reference depends on) and says why it renders one
+// again.
 #include "io/image.h"
 #include "support/test_support.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 
 using namespace plume;
+namespace fs = std::filesystem;
 
 namespace {
 
+const std::string kScene = test::sourcePath("volumes/smoke/smoke.json");
+
 Image renderSeed(const std::string& dir, int seed) {
   const std::string out = dir + "/seed" + std::to_string(seed) + ".exr";
-  test::RunResult r = test::runPlume({"reference", test::sourcePath("volumes/smoke/smoke.json"), "-o", out,
+  test::RunResult r = test::runPlume({"reference", kScene, "-o", out,
                                       "--frames", "12", "--spp", "256", "--seed", std::to_string(seed), "-q"});
   EXPECT_EQ(r.exitCode, 0) << r.output;
   return readExr(out);
@@ -44,4 +50,81 @@ TEST(ReferenceCli, VarianceImageMatchesSpreadBetweenSeedsOnBundledSmoke) {
   EXPECT_EQ(a.meta["tracking_truncated"], "0");
   EXPECT_FALSE(a.meta["wall_time_s"].empty());
   EXPECT_EQ(renderSeed(dir, 1).rgb, a.rgb) << "same seed, same pixels";
+}
+
+TEST(ReferenceCli, ResumeRendersAFrameAgainWhenASettingItDependsOnChanged) {
+  const std::string dir = test::outputDir("reference_cli_resume");
+  const std::string out = dir + "/f.exr";
+  struct Step {
+    std::vector<std::string> args;
+    std::string expected;  // in the log: "is complete, skipped" or the setting that changed
+  };
+  // Each step resumes over the previous step's frame with the full set of arguments. The bundled
+  // scene sets max_bounces 8, spp 4, seed 1 and the default rr_start_bounce 3.
+  const std::vector<Step> steps = {
+      {{"--width", "16"}, ""},
+      {{"--width", "16"}, "is complete, skipped"},
+      {{"--width", "16", "--mode", "restir", "--restir-radius", "5"}, "is complete, skipped"},  // ignored
+      {{"--width", "16", "--max-bounces", "2"}, "max_bounces 8 -> 2"},
+      {{"--width", "16", "--max-bounces", "2", "--rr-start-bounce", "1"}, "rr_start_bounce 3 -> 1"},
+      {{"--width", "16", "--max-bounces", "2", "--rr-start-bounce", "1", "--seed", "7"}, "seed 1 -> 7"},
+      {{"--width", "16", "--max-bounces", "2", "--rr-start-bounce", "1", "--seed", "7", "--spp", "3"}, "spp 4 -> 3"},
+      {{"--width", "12", "--max-bounces", "2", "--rr-start-bounce", "1", "--seed", "7", "--spp", "3"},
+       "camera.width 16 -> 12"},
+      {{"--width", "12", "--max-bounces", "2", "--rr-start-bounce", "1", "--seed", "7", "--spp", "3"},
+       "is complete, skipped"},
+  };
+
+  Image previous;
+  for (size_t i = 0; i < steps.size(); ++i) {
+    std::vector<std::string> args = {"reference", kScene, "-o", out, "--frames", "2", "--height", "16", "--resume"};
+    args.insert(args.end(), steps[i].args.begin(), steps[i].args.end());
+    const auto before = fs::exists(out) ? fs::last_write_time(out) : fs::file_time_type{};
+    test::RunResult r = test::runPlume(args);
+    ASSERT_EQ(r.exitCode, 0) << "step " << i << ":\n" << r.output;
+    Image now = readExr(out);
+    if (!steps[i].expected.empty()) {
+      EXPECT_NE(r.output.find(steps[i].expected), std::string::npos) << "step " << i << ":\n" << r.output;
+    }
+    if (steps[i].expected == "is complete, skipped") {
+      EXPECT_EQ(fs::last_write_time(out), before) << "step " << i << ": the frame must not be rewritten";
+    } else if (i > 0) {
+      EXPECT_NE(r.output.find("exists but it was rendered with other settings"), std::string::npos) << r.output;
+      EXPECT_NE(fs::last_write_time(out), before) << "step " << i << ": the frame must be rewritten";
+      EXPECT_NE(now.meta["render_key"], previous.meta["render_key"]) << "step " << i;
+      EXPECT_TRUE(now.width != previous.width || now.rgb != previous.rgb) << "step " << i << ": same pixels";
+    }
+    EXPECT_NE(now.meta["render_key"].find("mode=reference"), std::string::npos) << now.meta["render_key"];
+    EXPECT_EQ(now.meta["render_key"].find("restir_"), std::string::npos) << now.meta["render_key"];
+    previous = now;
+  }
+  EXPECT_EQ(previous.meta["spp"], "3");
+  EXPECT_EQ(previous.meta["seed"], "7");
+  EXPECT_EQ(previous.width, 12);
+}
+
+TEST(ReferenceCli, ResumeRendersAgainAFrameWithoutARenderKeyOrFromTheGpuRenderer) {
+  const std::string dir = test::outputDir("reference_cli_resume_old");
+  const std::string out = dir + "/f.exr";
+  const std::vector<std::string> args = {"reference", kScene, "-o", out, "--frames", "2", "--width", "16",
+                                         "--height", "16", "--spp", "2", "--resume"};
+  ASSERT_EQ(test::runPlume(args).exitCode, 0);
+  Image old = readExr(out);
+  ASSERT_FALSE(old.meta["render_key"].empty());
+  old.meta.erase("render_key");  // as written by a plume from before render keys
+  writeExr(out, old);
+  test::RunResult r = test::runPlume(args);
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_NE(r.output.find("no render_key"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("is complete, skipped"), std::string::npos) << r.output;
+  EXPECT_FALSE(readExr(out).meta["render_key"].empty()) << "the frame must have been written again";
+
+  // The same frame from `plume render` (same size, spp and seed) is not a reference frame.
+  test::RunResult gpu = test::runPlume({"render", kScene, "-o", out, "--frames", "2", "--width", "16", "--height",
+                                        "16", "--spp", "2", "-q"});
+  ASSERT_EQ(gpu.exitCode, 0) << gpu.output;
+  r = test::runPlume(args);
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_NE(r.output.find("mode pt -> reference"), std::string::npos) << r.output;
+  EXPECT_EQ(readExr(out).meta["mode"], "reference");
 }

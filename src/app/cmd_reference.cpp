@@ -10,11 +10,22 @@
 #include "scene/scene.h"
 
 #include <memory>
+#include <string>
 
 namespace plume {
 namespace {
 
 using ReferenceArgs = FrameJobArgs;
+
+// The frame's render key (app/frame_output.h): the scene's part without the settings the reference
+// ignores (render.mode, the ReSTIR ones), and "mode=reference", so that --resume over frames of
+// `plume render` renders them again. Per-pixel random streams: no batch or thread count in it.
+RenderKey referenceRenderKey(const Scene& scene, int frame) {
+  RenderKey key = sceneRenderKey(scene, frame,
+                                 [](const std::string& k) { return k != "mode" && k.rfind("restir_", 0) != 0; });
+  key.add("mode", "reference");
+  return key;
+}
 
 int runReference(const ReferenceArgs& a) {
   Scene scene = loadJobScene(a);
@@ -23,7 +34,8 @@ int runReference(const ReferenceArgs& a) {
   a.outputs.check(rs);
   const Medium& medium = scene.media.at(0);
   for (int frame = rs.frameFirst; frame <= rs.frameLast; ++frame) {
-    if (a.outputs.skip(frame, rs)) continue;
+    const RenderKey key = referenceRenderKey(scene, frame);
+    if (a.outputs.skip(frame, key)) continue;
     LoadedGrid grid = loadFloatGrid(medium.vdbPath(frame), medium.densityGrid);
     if (grid.replacedValues > 0) {
       logWarn(strf("%s: %llu NaN, infinite or negative values replaced by 0", grid.path.c_str(),
@@ -36,6 +48,7 @@ int runReference(const ReferenceArgs& a) {
     Image image = ref::renderReference(scene, grid.grid, opt, &stats);
     image.meta["scene"] = a.scene;
     image.meta["replaced_values"] = std::to_string(grid.replacedValues);
+    image.meta["render_key"] = key.text();
     a.outputs.write(frame, image);
     logInfo(strf("frame %d: %s  %.2fs  %.0f samples/s", frame, a.outputs.exrPath(frame).c_str(), stats.seconds,
                  stats.samplesPerSecond()));

@@ -163,22 +163,6 @@ bool FrameOutputs::skip(int frame, const RenderKey& key) const {
   return false;
 }
 
-bool FrameOutputs::skip(int frame, const RenderSettings& rs) const {
-  const std::string path = exrPath(frame);
-  if (!resume || !std::filesystem::exists(path)) return false;
-  try {
-    Image img = readExr(path);
-    bool same = img.meta["spp"] == std::to_string(rs.spp) && img.meta["seed"] == std::to_string(rs.seed) &&
-                img.meta["frame"] == std::to_string(frame);
-    if (same && (!png || std::filesystem::exists(pngPath(frame)))) {
-      logInfo(strf("frame %d: %s is complete, skipped", frame, path.c_str()));
-      return true;
-    }
-  } catch (const InputError&) {
-  }
-  return false;
-}
-
 namespace {
 
 // AtomicFile names its temporary ".<name>.tmp<pid>" beside the target (core/atomic_file.cpp).

@@ -2,8 +2,7 @@
 // writability checks, resume (a frame is complete when its EXR reads back with the same
 // settings in its header), EXR + optional PNG written atomically; and the progress display of a
 // frame sequence (bar with per-frame time and ETA on a terminal, one log line per frame otherwise).
-// `plume render` compares a full render key (every setting the pixels depend on); `plume
-// reference` still compares spp and seed only.
+// Both commands compare a full render key (every setting the pixels depend on).
 #pragma once
 
 #include "app/settings_cli.h"
@@ -55,9 +54,6 @@ struct FrameOutputs {
   // equals `key`. Otherwise logs why an existing frame is rendered again: other settings (which
   // ones), no key (written by a plume from before render keys), unreadable, or no PNG.
   bool skip(int frame, const RenderKey& key) const;
-  // --resume and the frame's EXR is complete with the same spp and seed (plume reference, whose
-  // EXRs carry no render key).
-  bool skip(int frame, const RenderSettings& rs) const;
   // Atomic writes; first removes temporaries of this frame's files left by a killed run (a
   // process that no longer exists on this host, untouched for a minute).
   void write(int frame, const Image& image) const;
