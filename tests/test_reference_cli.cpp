@@ -2,7 +2,8 @@
 // variance image agrees with the spread between two independent seeds, the same seed gives the
 // same pixels, and the header carries the run's metadata; --resume keeps a frame only when its
 // header's render key matches (the settings the reference depends on) and says why it renders one
-// again.
+// again; a VDB frame missing from the range fails before the first frame renders.
+#include "core/log.h"
 #include "io/image.h"
 #include "support/test_support.h"
 
@@ -127,4 +128,28 @@ TEST(ReferenceCli, ResumeRendersAgainAFrameWithoutARenderKeyOrFromTheGpuRenderer
   ASSERT_EQ(r.exitCode, 0) << r.output;
   EXPECT_NE(r.output.find("mode pt -> reference"), std::string::npos) << r.output;
   EXPECT_EQ(readExr(out).meta["mode"], "reference");
+}
+
+// A hole in an animated VDB sequence fails the job up front, naming the file and the scene key.
+TEST(ReferenceCli, AMissingVdbFrameFailsBeforeAnyFrameIsRendered) {
+  const std::string dir = test::outputDir("reference_cli_missing_frame");
+  fs::copy_file(kScene, dir + "/smoke.json");  // its VDB path is relative: it resolves to the copies
+  for (int f : {1, 2, 4}) {
+    const std::string name = strf("smoke_%04d.vdb", f);
+    fs::copy_file(test::sourcePath("volumes/smoke/" + name), dir + "/" + name);
+  }
+  const std::string out = dir + "/out";
+  fs::create_directories(out);
+  auto run = [&](const std::string& frames) {
+    return test::runPlume({"reference", dir + "/smoke.json", "-o", out + "/f_{frame:04}.exr", "--frames", frames,
+                           "--width", "16", "--height", "16", "--spp", "1"});
+  };
+  test::RunResult r = run("1-4");
+  EXPECT_EQ(r.exitCode, 2) << r.output;
+  EXPECT_NE(r.output.find(dir + "/smoke.json: media[0].vdb: frame 3: file not found: "), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("smoke_0003.vdb"), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::is_empty(out)) << "no frame may be rendered";
+  r = run("1-2");
+  EXPECT_EQ(r.exitCode, 0) << "the frames that are there render:\n" << r.output;
 }

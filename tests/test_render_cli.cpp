@@ -4,7 +4,8 @@
 // size, settings, scene) and says why it renders one again; same seed and device give the same
 // pixels; ReSTIR frames depend on where their history starts and nothing else; both estimators
 // show the same progress and write the full header; a device that does not exist exits 3 naming
-// the devices there are; --preroll is accepted (a no-op for the path tracer).
+// the devices there are; a VDB frame missing from the range fails before the first frame renders;
+// --preroll is accepted (a no-op for the path tracer).
 #include "core/log.h"
 #include "gpu/context.h"
 #include "io/image.h"
@@ -62,6 +63,17 @@ std::string smokeSceneWithDensity(const std::string& dir, const std::string& nam
   const std::string path = dir + "/" + name;
   std::ofstream(path) << text;
   return path;
+}
+
+// A copy of the bundled smoke scene in `dir` with only the listed frames of its VDB sequence beside
+// it (the scene's relative VDB path resolves to the copies).
+std::string smokeSceneWithFrames(const std::string& dir, const std::vector<int>& frames) {
+  fs::copy_file(kScene, dir + "/smoke.json");
+  for (int f : frames) {
+    const std::string name = strf("smoke_%04d.vdb", f);
+    fs::copy_file(test::sourcePath("volumes/smoke/" + name), dir + "/" + name);
+  }
+  return dir + "/smoke.json";
 }
 
 }  // namespace
@@ -157,6 +169,32 @@ TEST(RenderCli, UnknownDeviceExitsThreeNamingTheDevices) {
     EXPECT_NE(r.output.find(name), std::string::npos) << "the message should list " << name << ":\n" << r.output;
   }
   EXPECT_FALSE(fs::exists(dir + "/x.exr"));
+}
+
+// A hole in an animated VDB sequence fails the job up front, naming the file and the scene key,
+// not when the frame is reached hours later.
+TEST(RenderCli, AMissingVdbFrameFailsBeforeAnyFrameIsRendered) {
+  const std::string dir = test::outputDir("render_cli_missing_frame");
+  const std::string scene = smokeSceneWithFrames(dir, {1, 2, 4});
+  const std::string out = dir + "/out";
+  fs::create_directories(out);
+  auto expectFails = [&](const std::string& frames, const std::vector<std::string>& extra,
+                         const std::vector<std::string>& expected) {
+    std::vector<std::string> args = {"--width", "16"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    test::RunResult r = test::runPlume(tinyArgs(scene, out + "/f_{frame:04}.exr", frames, args));
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    for (const std::string& e : expected) EXPECT_NE(r.output.find(e), std::string::npos) << e << " in\n" << r.output;
+    EXPECT_TRUE(fs::is_empty(out)) << "no frame may be rendered";
+  };
+  expectFails("1-5", {}, {scene + ": media[0].vdb: frame 3: file not found: ", "smoke_0003.vdb",
+                          "(2 of frames 1-5 cannot be read)"});
+  expectFails("1-5", {"--resume"}, {"media[0].vdb: frame 3: file not found"});
+  expectFails("4", {"--mode", "restir", "--preroll", "2"}, {"media[0].vdb: frame 3: file not found"});  // pre-roll
+  fs::create_directory(dir + "/smoke_0003.vdb");
+  expectFails("3", {}, {"media[0].vdb: frame 3: not a regular file: ", "smoke_0003.vdb"});
+  test::RunResult r = test::runPlume(tinyArgs(scene, out + "/f_{frame:04}.exr", "1-2", {"--width", "16"}));
+  EXPECT_EQ(r.exitCode, 0) << "the frames that are there render:\n" << r.output;
 }
 
 TEST(RenderCli, PrerollIsAcceptedAndANoOpForThePathTracer) {

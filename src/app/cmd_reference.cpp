@@ -32,6 +32,7 @@ int runReference(const ReferenceArgs& a) {
   ref::checkReferenceSupports(scene);
   const RenderSettings& rs = scene.render;
   a.outputs.check(rs);
+  checkVolumeFrames(scene, rs.frameFirst, rs.frameLast);
   const Medium& medium = scene.media.at(0);
   for (int frame = rs.frameFirst; frame <= rs.frameLast; ++frame) {
     const RenderKey key = referenceRenderKey(scene, frame);

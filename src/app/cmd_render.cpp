@@ -249,6 +249,7 @@ int runRender(const RenderArgs& a) {
                                        Restir::kMaxIterations, rs.spp));
   }
   a.outputs.check(rs);
+  checkVolumeFrames(scene, prerollRange(scene, a.preroll).first, rs.frameLast);  // before the device starts
   BakeOptions bakeOptions;
   bakeOptions.format = a.texels == "float32" ? TexelFormat::Float32 : TexelFormat::Float16;
   bakeOptions.meanField = rs.mode != "pt";  // only ReSTIR reads it

@@ -2,7 +2,8 @@
 // writability checks, resume (a frame is complete when its EXR reads back with the same
 // settings in its header), EXR + optional PNG written atomically; and the progress display of a
 // frame sequence (bar with per-frame time and ETA on a terminal, one log line per frame otherwise).
-// Both commands compare a full render key (every setting the pixels depend on).
+// Both commands compare a full render key (every setting the pixels depend on) and check up front
+// that the VDB file of every frame they are asked for is there.
 #pragma once
 
 #include "app/settings_cli.h"
@@ -40,6 +41,12 @@ struct RenderKey {
 // Not included: what only the history of a temporal estimator depends on (where a chunk starts,
 // --preroll), the device, plume's version, and the contents of the files named (VDB, OBJ, maps).
 RenderKey sceneRenderKey(const Scene& scene, int frame, const std::function<bool(const std::string&)>& uses);
+
+// Throws InputError "<scene>: media[i].vdb: frame F: file not found: <path>" (or "not a regular
+// file", "cannot read") for the first frame in [first, last] whose VDB file of some medium cannot
+// be read, so that a sequence with a hole fails before hours of rendering rather than at the hole.
+// Frames --resume will skip are checked too: the range is what the job was asked for.
+void checkVolumeFrames(const Scene& scene, int first, int last);
 
 struct FrameOutputs {
   std::string pattern;  // -o value; {frame:04} replaced per frame
