@@ -4,8 +4,9 @@
 // size, settings, scene) and says why it renders one again; same seed and device give the same
 // pixels; ReSTIR frames depend on where their history starts and nothing else; both estimators
 // show the same progress and write the full header; a device that does not exist exits 3 naming
-// the devices there are; a VDB frame missing from the range fails before the first frame renders;
-// --preroll is accepted (a no-op for the path tracer).
+// the devices there are, while missing or broken shaders exit 4 (the same on every machine); a
+// VDB frame missing from the range fails before the first frame renders; --preroll is accepted
+// (a no-op for the path tracer).
 #include "core/log.h"
 #include "gpu/context.h"
 #include "io/image.h"
@@ -15,10 +16,12 @@
 
 #include <chrono>
 #include <csignal>
+#include <cstdlib>
 #include <fcntl.h>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <optional>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <thread>
@@ -75,6 +78,26 @@ std::string smokeSceneWithFrames(const std::string& dir, const std::vector<int>&
   }
   return dir + "/smoke.json";
 }
+
+// Sets an environment variable for the plume processes a test starts; restores it after.
+class ScopedEnv {
+ public:
+  ScopedEnv(const char* name, const std::string& value) : name_(name) {
+    if (const char* old = std::getenv(name)) old_ = old;
+    setenv(name, value.c_str(), 1);
+  }
+  ~ScopedEnv() {
+    if (old_) {
+      setenv(name_, old_->c_str(), 1);
+    } else {
+      unsetenv(name_);
+    }
+  }
+
+ private:
+  const char* name_;
+  std::optional<std::string> old_;
+};
 
 }  // namespace
 
@@ -168,6 +191,29 @@ TEST(RenderCli, UnknownDeviceExitsThreeNamingTheDevices) {
   for (const std::string& name : gpu::Context::listDevices()) {
     EXPECT_NE(r.output.find(name), std::string::npos) << "the message should list " << name << ":\n" << r.output;
   }
+  EXPECT_FALSE(fs::exists(dir + "/x.exr"));
+}
+
+// Exit code 3 says "retry elsewhere"; a missing or broken shader fails the same way everywhere.
+TEST(RenderCli, MissingShadersExitFourNotThree) {
+  const std::string dir = test::outputDir("render_cli_shaders");
+  fs::create_directories(dir + "/empty");
+  {
+    ScopedEnv env("PLUME_SHADER_DIR", dir + "/empty");
+    test::RunResult r = test::runPlume(tinyArgs(kScene, dir + "/x.exr", "1", {"--width", "16"}));
+    EXPECT_EQ(r.exitCode, 4) << r.output;
+    EXPECT_NE(r.output.find("shader not found: " + dir + "/empty/"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("PLUME_SHADER_DIR"), std::string::npos) << r.output;
+  }
+  // A copy of the shaders whose compute entry points do not compile.
+  fs::copy(test::sourcePath("shaders"), dir + "/broken", fs::copy_options::recursive);
+  for (const auto& e : fs::recursive_directory_iterator(dir + "/broken")) {
+    if (e.path().extension() == ".comp") std::ofstream(e.path()) << "#version 450\nvoid main() { not glsl }\n";
+  }
+  ScopedEnv env("PLUME_SHADER_DIR", dir + "/broken");
+  test::RunResult r = test::runPlume(tinyArgs(kScene, dir + "/x.exr", "1", {"--width", "16"}));
+  EXPECT_EQ(r.exitCode, 4) << r.output;
+  EXPECT_NE(r.output.find("failed to compile"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(dir + "/x.exr"));
 }
 

@@ -34,5 +34,8 @@ int main(int argc, char** argv) {
   } catch (const DeviceError& e) {
     std::fprintf(stderr, "plume: device error: %s\n", e.what());
     return kExitDeviceFailure;
+  } catch (const InternalError& e) {
+    std::fprintf(stderr, "plume: internal error: %s\n", e.what());
+    return kExitInternal;
   }
 }

@@ -9,15 +9,22 @@
 
 namespace plume::gpu {
 
+namespace {
+constexpr const char* kTooLargeHint = "the input is too large for this device: a smaller image or a smaller or "
+                                      "coarser volume, or a device with larger limits (--device)";
+}  // namespace
+
 // ---------------------------------------------------------------------------------------------
 Buffer::Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, const std::string& name,
                MemoryUse use)
     : ctx_(&ctx), size_(size) {
   if (size == 0) size = size_ = 4;  // Vulkan forbids empty buffers; an empty array binds 4 bytes
+  // Beyond a limit of the device: the size follows from the input (image size, volume), so the
+  // same input fails the same way on this device every time: bad input, not a device failure.
   if ((usage & VK_BUFFER_USAGE_STORAGE_BUFFER_BIT) && size > ctx.limits().maxStorageBufferRange) {
-    throw DeviceError(strf("%s: %s needs %.1f MiB, more than the device's storage buffer limit of %.1f MiB",
-                           ctx.deviceName().c_str(), name.c_str(), size / 1048576.0,
-                           ctx.limits().maxStorageBufferRange / 1048576.0));
+    throw InputError(strf("%s: %s needs %.1f MiB, more than the device's storage buffer limit of %.1f MiB (%s)",
+                          ctx.deviceName().c_str(), name.c_str(), size / 1048576.0,
+                          ctx.limits().maxStorageBufferRange / 1048576.0, kTooLargeHint));
   }
   VkBufferCreateInfo bi{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
   bi.size = size;
@@ -108,8 +115,8 @@ Image3D::Image3D(Context& ctx, glm::ivec3 extent, VkFormat format, size_t texelB
     : ctx_(&ctx), extent_(extent), texelBytes_(texelBytes) {
   const uint32_t maxSide = ctx.limits().maxImageDimension3D;
   if (uint32_t(extent.x) > maxSide || uint32_t(extent.y) > maxSide || uint32_t(extent.z) > maxSide) {
-    throw DeviceError(strf("%s: %s needs a %dx%dx%d 3D image; the device allows %u per side",
-                           ctx.deviceName().c_str(), name.c_str(), extent.x, extent.y, extent.z, maxSide));
+    throw InputError(strf("%s: %s needs a %dx%dx%d 3D image; the device allows %u per side (%s)",
+                          ctx.deviceName().c_str(), name.c_str(), extent.x, extent.y, extent.z, maxSide, kTooLargeHint));
   }
   VkImageCreateInfo ii{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
   ii.imageType = VK_IMAGE_TYPE_3D;

@@ -21,7 +21,8 @@ enum class MemoryUse {
 class Buffer {
  public:
   Buffer() = default;
-  // `name` appears in errors (e.g. a buffer larger than the device allows).
+  // `name` appears in errors (e.g. a buffer larger than the device allows: an InputError, since the
+  // sizes follow from the input).
   Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, const std::string& name,
          MemoryUse use = MemoryUse::Device);
   ~Buffer();

@@ -94,7 +94,11 @@ std::string ShaderCompiler::defaultCacheDir() {
 
 std::string ShaderCompiler::readSource(const std::string& relPath) const {
   fs::path p = fs::path(root_) / relPath;
-  if (!fs::exists(p)) throw DeviceError("shader not found: " + p.string() + " (set PLUME_SHADER_DIR)");
+  if (!fs::exists(p)) {
+    throw InternalError("shader not found: " + p.string() +
+                        " (plume's installation is incomplete, or PLUME_SHADER_DIR names the wrong folder: set it "
+                        "to the shaders/ folder of this plume)");
+  }
   return slurp(p);
 }
 
@@ -151,12 +155,12 @@ std::vector<uint32_t> ShaderCompiler::compile(const std::string& relPath, const 
   Includer includer(root_);
   const EShMessages messages = EShMessages(EShMsgSpvRules | EShMsgVulkanRules);
   if (!shader.parse(GetDefaultResources(), 450, false, messages, includer)) {
-    throw DeviceError("shader " + relPath + " failed to compile:\n" + shader.getInfoLog());
+    throw InternalError("shader " + relPath + " failed to compile:\n" + shader.getInfoLog());
   }
   glslang::TProgram program;
   program.addShader(&shader);
   if (!program.link(messages)) {
-    throw DeviceError("shader " + relPath + " failed to link:\n" + program.getInfoLog());
+    throw InternalError("shader " + relPath + " failed to link:\n" + program.getInfoLog());
   }
   std::vector<uint32_t> spirv;
   glslang::SpvOptions options;

@@ -18,7 +18,8 @@ class ShaderCompiler {
   // the environment variable PLUME_SHADER_DIR (an installed plume).
   explicit ShaderCompiler(std::string shaderRoot = {}, std::string cacheDir = {});
 
-  // Throws DeviceError with glslang's log on a compile error.
+  // Throws InternalError (exit code 4: the same on every device) for a missing shader file and with
+  // glslang's log on a compile or link error.
   std::vector<uint32_t> compile(const std::string& relPath, const ShaderDefines& defines);
 
   uint64_t compiles() const { return compiles_; }

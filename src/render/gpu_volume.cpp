@@ -29,7 +29,7 @@ GpuVolumeResources::GpuVolumeResources(gpu::Context& ctx, const BakedVolume& bak
     majorants.insert(majorants.end(), L.max.begin(), L.max.end());
   }
   if (!empty && (levels == 0 || bake.maxLevels[0].dims != bake.brickDims)) {
-    throw DeviceError("bake: level 0 of the majorant hierarchy must match the indirection grid");
+    throw InternalError("bake: level 0 of the majorant hierarchy must match the indirection grid");
   }
   params_.info = glm::uvec4(uint32_t(levels), 0, 0, 0);
 
@@ -45,7 +45,10 @@ GpuVolumeResources::GpuVolumeResources(gpu::Context& ctx, const BakedVolume& bak
 
   // Slot indices become packed slot coordinates (x | y << 10 | z << 20): no division in shaders.
   if (glm::any(glm::greaterThan(bake.atlasSlots, glm::ivec3(1024)))) {
-    throw DeviceError("bake: more than 1024 atlas slots per axis");
+    // Unreachable with the bake's default layout (BakeOptions::maxAtlasSlotsPerAxis, which makes
+    // larger volumes an InputError naming the file): a bake configured past the packing.
+    throw InternalError(strf("bake: %dx%dx%d atlas slots; the packed slot coordinates hold at most 1024 per axis",
+                             bake.atlasSlots.x, bake.atlasSlots.y, bake.atlasSlots.z));
   }
   std::vector<uint32_t> packed(bake.indirection.size());
   for (size_t i = 0; i < packed.size(); ++i) {
