@@ -1,13 +1,14 @@
-// Tier d foundations (DESIGN §7): the CPU reference against analytic images.
+// Tier d foundations (DESIGN §7): the CPU reference against analytic images, each checked with
+// a per-pixel Z-test and an aggregate z-test on the image mean (support/reference_check.h).
 //  - White furnace: albedo 1, constant environment L, medium fully inside the view: every
-//    pixel is L (energy conservation), checked with a per-pixel Z-test.
+//    pixel is L (energy conservation).
 //  - Single scattering in a homogeneous box lit by a sun straight above: the reference matches
 //    a numerical integration of the single-scattering equation over each pixel's footprint.
 //  - The reference's variance image agrees with the spread between two independent seeds.
-#include "core/stats.h"
 #include "reference/reference.h"
 #include "shaders/shared/phase.h"
 #include "support/grids.h"
+#include "support/reference_check.h"
 #include "support/scenes.h"
 #include "support/test_support.h"
 
@@ -39,21 +40,10 @@ Image renderQuiet(const Scene& scene, openvdb::FloatGrid::ConstPtr grid) {
   return ref::renderReference(scene, grid, opt);
 }
 
-void expectPass(const ZTestResult& z, const std::string& name, const Image& a, const Image& b) {
-  EXPECT_TRUE(z.pass) << z.summary();
-  if (!z.pass) writeFailureImages(test::outputDir("reference_images"), name, a, b, z);
-}
-
-// Aggregate Z-score of the whole image: sum(a - exact) / sqrt(sum var(a)). Per-pixel tests
-// with a multiple-comparison correction are weak against a small global scale error; this
-// catches one.
-double aggregateZ(const Image& a, std::span<const float> exact) {
-  double diff = 0, var = 0;
-  for (size_t i = 0; i < a.rgb.size(); ++i) {
-    diff += double(a.rgb[i]) - exact[i];
-    var += a.var[i];
-  }
-  return var > 0 ? diff / std::sqrt(var) : (diff == 0 ? 0.0 : INFINITY);
+test::ReferenceCheckOptions checkOptions() {
+  test::ReferenceCheckOptions options;
+  options.outputGroup = "reference_images";
+  return options;
 }
 
 }  // namespace
@@ -72,15 +62,12 @@ TEST(ReferenceImages, WhiteFurnaceIsUniform) {
   s.render.maxBounces = 100000;  // albedo 1: paths end by escaping
   s.render.spp = 256;
   Image img = renderQuiet(s, grid);
-  ZTestResult z = zTestAgainst(img, env.radiance);
-  expectPass(z, "furnace", img, img);
-  EXPECT_NEAR(z.meanRatio, 1.0, 0.01);
   std::vector<float> exact(img.rgb.size());
   for (size_t i = 0; i < exact.size(); ++i) exact[i] = env.radiance[int(i % 3)];
-  EXPECT_LT(std::abs(aggregateZ(img, exact)), 4.0);
+  test::expectMatchesExact(img, exact, "furnace", checkOptions());
   // The test is sensitive: a 2% energy loss must fail it.
   for (float& v : exact) v *= 0.98f;
-  EXPECT_GT(std::abs(aggregateZ(img, exact)), 4.0);
+  EXPECT_FALSE(test::checkAgainstExact(img, exact).aggregate.pass);
 }
 
 namespace {
@@ -167,16 +154,11 @@ TEST(ReferenceImages, SingleScatteringBoxMatchesNumericalIntegration) {
         }
       for (int c = 0; c < 3; ++c) exact[3 * (py * size + px) + c] = float(sum / (sub * sub));
     }
-  ZTestResult z = zTestAgainst(img, exact);
-  Image exactImg = img;
-  exactImg.rgb = exact;
-  expectPass(z, "single_scatter", img, exactImg);
-  EXPECT_NEAR(z.meanRatio, 1.0, 0.01);
-  EXPECT_LT(std::abs(aggregateZ(img, exact)), 4.0);
+  test::expectMatchesExact(img, exact, "single_scatter", checkOptions());
   // Sensitivity: a 2% error in the sun's strength must fail.
   std::vector<float> wrong = exact;
   for (float& v : wrong) v *= 1.02f;
-  EXPECT_GT(std::abs(aggregateZ(img, wrong)), 4.0);
+  EXPECT_FALSE(test::checkAgainstExact(img, wrong).aggregate.pass);
 }
 
 TEST(ReferenceImages, VarianceImageMatchesSpreadBetweenSeeds) {
@@ -201,8 +183,7 @@ TEST(ReferenceImages, VarianceImageMatchesSpreadBetweenSeeds) {
   ASSERT_GT(predicted, 0);
   EXPECT_NEAR(spread / predicted, 1.0, 0.1) << "spread " << spread << " predicted " << predicted;
   // And the two seeds agree with each other.
-  ZTestResult z = zTest(a, b);
-  expectPass(z, "seeds", a, b);
+  test::expectMatchesReference(a, b, "seeds", checkOptions());
   // Same seed, same image (determinism independent of threading).
   s.render.seed = 2;
   EXPECT_EQ(renderQuiet(s, grid).rgb, b.rgb);
