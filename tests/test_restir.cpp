@@ -1,16 +1,18 @@
 // Volumetric ReSTIR (DESIGN §4.2, §7). Tier b: the MIS weights of reuse sum to 1. Tier d: the
 // ReSTIR estimator against the independent CPU reference, per-pixel Z-test with a Šidák
-// correction, validation layers on: candidates and final shading alone; spatial reuse (pairwise
-// MIS and the generalised balance heuristic); temporal reuse with a still and a moving camera;
-// and restir-biased, whose bias is measured and bounded. Each GPU sample is the last frame of an
-// independent run (its own seed sequence), so samples are independent and the variance of the
-// mean is estimated honestly even with temporal reuse.
-#include "core/stats.h"
+// correction and an aggregate z-test on the image mean (support/reference_check.h), validation
+// layers on: candidates and final shading alone; spatial reuse (pairwise MIS and the generalised
+// balance heuristic); temporal reuse with a still and a moving camera; and restir-biased, whose
+// bias is measured and bounded. Each GPU sample is the last frame of an independent run (its own
+// seed sequence), so samples are independent and the variance of the mean is estimated honestly
+// even with temporal reuse; so is that of the image mean, from each run's image mean, though
+// spatial reuse correlates the pixels of a run.
 #include "media/vdb_loader.h"
 #include "reference/reference.h"
 #include "render/restir.h"
 #include "support/gpu_fixture.h"
 #include "support/grids.h"
+#include "support/reference_check.h"
 #include "support/scenes.h"
 #include "support/test_support.h"
 
@@ -19,6 +21,7 @@
 #include <chrono>
 #include <cstdio>
 #include <random>
+#include <stdexcept>
 
 using namespace plume;
 
@@ -43,13 +46,46 @@ Scene baseScene(int size) {
   return s;
 }
 
-// Mean and variance of the mean of independent images.
+// Environment overrides of the suite's run counts and seeds, for investigating a failure (more
+// runs, other seeds). The thresholds were designed for the defaults: an override is announced
+// on stdout, recorded in the test's XML properties and named in failure messages.
+constexpr const char* kKnobs[] = {"PLUME_RESTIR_RUNS", "PLUME_RESTIR_SEQ", "PLUME_RESTIR_REF_SEED"};
+
+int knob(const char* name, int defaultValue) {
+  const char* v = std::getenv(name);
+  if (!v) return defaultValue;
+  const int value = std::atoi(v);
+  std::printf("[restir] NON-DEFAULT RUN: %s=%d (default %d); the test thresholds were designed for the defaults\n",
+              name, value, defaultValue);
+  ::testing::Test::RecordProperty(name, value);
+  return value;
+}
+
+// "NAME=value ..." of the overrides in effect, or "".
+std::string overrides() {
+  std::string out;
+  for (const char* name : kKnobs) {
+    if (const char* v = std::getenv(name)) out += std::string(out.empty() ? "" : " ") + name + "=" + v;
+  }
+  return out;
+}
+
+// Mean and variance of the mean of independent images, and the variance of the image's mean
+// over pixels: spatial reuse shares samples between the pixels of one run, so the per-pixel
+// variances do not add up to it; the spread of each run's image mean does.
 struct Accumulator {
   std::vector<double> sum, sum2;
+  glm::dvec3 meanSum{0.0}, meanSum2{0.0};
   int n = 0;
   void add(const Image& im) {
     if (sum.empty()) sum.assign(im.rgb.size(), 0.0), sum2.assign(im.rgb.size(), 0.0);
-    for (size_t i = 0; i < im.rgb.size(); ++i) sum[i] += im.rgb[i], sum2[i] += double(im.rgb[i]) * im.rgb[i];
+    glm::dvec3 m(0.0);
+    for (size_t i = 0; i < im.rgb.size(); ++i) {
+      sum[i] += im.rgb[i], sum2[i] += double(im.rgb[i]) * im.rgb[i];
+      m[int(i % 3)] += im.rgb[i];
+    }
+    m /= double(im.rgb.size() / 3);
+    meanSum += m, meanSum2 += m * m;
     ++n;
   }
   Image image(int w, int h) const {
@@ -61,14 +97,19 @@ struct Accumulator {
     }
     return out;
   }
+  // Variance of the mean over runs of the image's per-channel mean over pixels.
+  glm::dvec3 imageMeanVariance() const {
+    const glm::dvec3 mean = meanSum / double(n);
+    return glm::max(meanSum2 / double(n) - mean * mean, glm::dvec3(0.0)) * (n / (n - 1.0)) / double(n);
+  }
 };
 
 struct RunSpec {
-  int runs = std::getenv("PLUME_RESTIR_RUNS") ? std::atoi(std::getenv("PLUME_RESTIR_RUNS")) : 256;  // independent runs
+  int runs = 256;           // independent runs (PLUME_RESTIR_RUNS overrides it)
   int framesPerRun = 1;     // frames rendered per run; the last one is the sample
   int firstFrame = 1;
   bool animatedGrid = false;
-  uint32_t sequenceOffset = std::getenv("PLUME_RESTIR_SEQ") ? uint32_t(std::atoi(std::getenv("PLUME_RESTIR_SEQ"))) : 0u;
+  int sequenceOffset = 0;   // added to each run's seed sequence (PLUME_RESTIR_SEQ overrides it)
 };
 
 std::shared_ptr<const BakedVolume> bakeOf(openvdb::FloatGrid::Ptr grid) {
@@ -80,6 +121,7 @@ std::shared_ptr<const BakedVolume> bakeOf(openvdb::FloatGrid::Ptr grid) {
 
 struct RestirRun {
   Image mean;
+  glm::dvec3 imageMeanVariance{0.0};  // see Accumulator
   uint32_t dropped = 0;
   double seconds = 0;
 };
@@ -99,25 +141,29 @@ RestirRun runRestir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scen
     volumes.push_back(std::make_unique<GpuVolumeResources>(ctx, *bakeOf(gridAt(spec.firstFrame + f)),
                                                            scene.media[0].densityScale));
   }
-  for (int run = 0; run < spec.runs; ++run) {
+  const int runs = knob("PLUME_RESTIR_RUNS", spec.runs);
+  if (runs < 2) throw std::invalid_argument("PLUME_RESTIR_RUNS: at least 2 runs are needed for a variance");
+  const uint32_t sequenceOffset = uint32_t(knob("PLUME_RESTIR_SEQ", spec.sequenceOffset));
+  for (int run = 0; run < runs; ++run) {
     restir.resetHistory();
     Image last;
     for (int f = 0; f < spec.framesPerRun; ++f) {
       const size_t cur = spec.animatedGrid ? size_t(f) : 0, prev = spec.animatedGrid && f > 0 ? size_t(f - 1) : cur;
       restir.setVolumes(*volumes[cur], *volumes[prev]);
-      last = restir.renderFrame(spec.firstFrame + f, uint32_t(run + 1) + spec.sequenceOffset);
+      last = restir.renderFrame(spec.firstFrame + f, uint32_t(run + 1) + sequenceOffset);
       out.dropped += restir.lastDroppedCount();
     }
     acc.add(last);
   }
   out.mean = acc.image(scene.camera.width, scene.camera.height);
+  out.imageMeanVariance = acc.imageMeanVariance();
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
 }
 
 Image reference(Scene s, openvdb::FloatGrid::Ptr grid, int spp, int frame = 1) {
   s.render.spp = spp;
-  s.render.seed = std::getenv("PLUME_RESTIR_REF_SEED") ? std::atoi(std::getenv("PLUME_RESTIR_REF_SEED")) : 777;
+  s.render.seed = knob("PLUME_RESTIR_REF_SEED", 777);
   ref::ReferenceOptions opt;
   opt.progress = false;
   opt.frame = frame;
@@ -131,14 +177,18 @@ RestirOptions noReuse() {
   return o;
 }
 
+test::ReferenceCheckOptions checkOptions(const RestirRun& run) {
+  test::ReferenceCheckOptions options;
+  options.imageMeanVariance = run.imageMeanVariance;
+  options.outputGroup = "restir";
+  return options;
+}
+
 void expectMatches(const RestirRun& run, const Image& ref, const std::string& name) {
-  ZTestResult z = zTest(run.mean, ref);
-  EXPECT_TRUE(z.pass) << name << ":\n" << z.summary();
-  EXPECT_NEAR(z.meanRatio, 1.0, 0.03) << name;
+  SCOPED_TRACE(overrides().empty() ? "default run counts and seeds" : "NON-DEFAULT: " + overrides());
+  test::expectMatchesReference(run.mean, ref, name, checkOptions(run));
   EXPECT_EQ(run.dropped, 0u) << name;
-  std::printf("[restir] %s: %.1f s, relMSE %.3g, mean ratio %.4f, worst z %.2f\n", name.c_str(), run.seconds,
-              z.relMse, z.meanRatio, z.worstZ);
-  if (!z.pass) writeFailureImages(test::outputDir("restir"), name, run.mean, ref, z);
+  std::printf("[restir] %s: %.1f s\n", name.c_str(), run.seconds);
 }
 
 }  // namespace
@@ -210,7 +260,7 @@ TEST_F(GpuRestir, MultipleScatteringWithoutReuseMatchesReference) {
   // Multi-bounce weights are heavy-tailed: 256 runs underestimate a pixel's variance now and
   // then (a z of -4.4 on one pixel with 256 runs, 2.7 worst with 2048 against the same
   // reference); 1024 runs keep the variance estimate honest.
-  if (!std::getenv("PLUME_RESTIR_RUNS")) spec.runs = 1024;
+  spec.runs = 1024;
   RestirRun run = runRestir(ctx(), compiler(), s, noReuse(), spec, [&](int) { return grid; });
   expectMatches(run, reference(s, grid, 512), "no_reuse_multi");
 }
@@ -312,14 +362,22 @@ TEST_F(GpuRestir, BiasedModeReportsBoundedBias) {
   spec.framesPerRun = 4;
   RestirRun run = runRestir(ctx(), compiler(), s, o, spec, [&](int) { return grid; });
   Image ref = reference(s, grid, 512);
-  ZTestResult z = zTest(run.mean, ref);
-  std::printf("[restir] restir-biased: measured bias: mean ratio %.4f, relMSE %.3g, %zu of %d pixels fail the "
-              "Z-test (worst z %.2f)\n", z.meanRatio, z.relMse, z.failingPixels, z.width * z.height, z.worstZ);
-  // Measured on lavapipe: mean ratio ~0.87 (energy lost where a neighbour's domain cannot produce
-  // the canonical path, compounded through the temporal history). The bounds catch a blow-up or
-  // a sign of gain, not the expected loss.
-  EXPECT_GT(z.meanRatio, 0.75);
-  EXPECT_LT(z.meanRatio, 1.05);
-  EXPECT_LT(z.relMse, 0.05);
+  const test::ReferenceCheck check = test::checkAgainstReference(run.mean, ref, checkOptions(run));
+  const glm::dvec3 ratio = check.aggregate.meanRatio(), z = check.aggregate.z;
+  std::printf("[restir] restir-biased: measured bias: mean ratio %.4f %.4f %.4f (aggregate z %.1f %.1f %.1f), relMSE "
+              "%.3g, %zu of %d pixels fail the Z-test (worst z %.2f)\n", ratio.x, ratio.y, ratio.z, z.x, z.y, z.z,
+              check.pixels.relMse, check.pixels.failingPixels, check.pixels.width * check.pixels.height,
+              check.pixels.worstZ);
+  for (int c = 0; c < 3; ++c) {
+    // The bias is a loss (energy lost where a neighbour's domain cannot produce the canonical
+    // path, compounded through the temporal history): a gain is an error, tested at the
+    // aggregate test's level.
+    EXPECT_LT(z[c], check.aggregate.threshold) << "channel " << c << ": restir-biased gains energy\n"
+                                               << check.summary();
+    // How much loss is acceptable is a design bound, not a statistical tolerance (measured on
+    // lavapipe: mean ratio ~0.87); it catches a blow-up, not the expected loss.
+    EXPECT_GT(ratio[c], 0.75) << "channel " << c << "\n" << check.summary();
+  }
+  EXPECT_LT(check.pixels.relMse, 0.05);
   EXPECT_EQ(run.dropped, 0u);
 }
