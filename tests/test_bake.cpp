@@ -210,7 +210,7 @@ TEST(Bake, FogSphereWithTilesMatchesBoxSampler) {
 
 TEST(Bake, BlenderSmokeMatchesBoxSampler) {
   const std::string shared = test::sharedVolumesPath();
-  if (shared.empty()) GTEST_SKIP() << "../shared/volumes not present";
+  if (shared.empty()) GTEST_SKIP() << test::sharedVolumesMissing();
   const LoadedGrid l = loadFloatGrid(shared + "/smoke/smoke_0012.vdb", "density");
   checkGrid(l.grid, 30000, 100000);
 }

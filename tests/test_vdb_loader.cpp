@@ -234,7 +234,7 @@ TEST(VdbLoader, InfoCommandDescribesGridsAndBakes) {
 
 TEST(VdbLoader, RealBlenderCacheLoadsDensityAndIgnoresOtherGrids) {
   const std::string shared = test::sharedVolumesPath();
-  if (shared.empty()) GTEST_SKIP() << "../shared/volumes not present";
+  if (shared.empty()) GTEST_SKIP() << test::sharedVolumesMissing();
   const std::string path = shared + "/raw/fluid_data_0040.vdb";
   const auto grids = inspectVdb(path);
   std::vector<std::string> names;

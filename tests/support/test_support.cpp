@@ -15,9 +15,20 @@ namespace fs = std::filesystem;
 
 std::string sourcePath(const std::string& rel) { return (fs::path(PLUME_SOURCE_DIR) / rel).string(); }
 
+namespace {
+fs::path sharedVolumesLocation() {
+  return fs::path(PLUME_SOURCE_DIR) / ".." / "shared" / "volumes" / "blender-mantaflow";
+}
+}  // namespace
+
 std::string sharedVolumesPath() {
-  fs::path p = fs::path(PLUME_SOURCE_DIR) / ".." / "shared" / "volumes" / "blender-mantaflow";
+  const fs::path p = sharedVolumesLocation();
   return fs::is_directory(p) ? fs::canonical(p).string() : std::string();
+}
+
+std::string sharedVolumesMissing() {
+  return "the Blender caches are not present: no folder " + sharedVolumesLocation().lexically_normal().string() +
+         " (../shared beside the checkout)";
 }
 
 std::string outputDir(const std::string& name) {

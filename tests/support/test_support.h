@@ -8,6 +8,8 @@ namespace plume::test {
 
 std::string sourcePath(const std::string& rel);  // PLUME_SOURCE_DIR / rel
 std::string sharedVolumesPath();                 // ../shared/volumes/blender-mantaflow, or "" if absent
+// Why a test that needs the Blender caches is skipped (the folder looked for): for GTEST_SKIP().
+std::string sharedVolumesMissing();
 // A fresh folder build/test-output/<name>/<Suite.Test>/ (emptied first); failing tests write files here.
 std::string outputDir(const std::string& name);
 
