@@ -94,7 +94,11 @@ TEST_F(GpuPathTracer, MultipleScatteringHighAlbedoMatchesReference) {
 }
 
 TEST_F(GpuPathTracer, CameraInsideTheMediumMatchesReference) {
-  // The camera sits in the box's constant interior, looking across it.
+  // The camera sits in the box's constant interior, looking across it. The point light in the
+  // medium makes both estimators' variance infinite: next-event estimation weighs a vertex at
+  // distance r by 1/r², and vertices fall within r with probability ~r³, so P(X > x) ~ x^-1.5.
+  // The standard error then shrinks like n^(-1/3), and the variance channels underestimate it:
+  // the aggregate test resolves only a ~5% bias here (2.4% with 8 times the samples).
   Scene s = baseScene({1.0f, 1.0f, 1.0f}, {0.2f, 0.8f, 0.3f}, 20);
   s.camera.base.fovY = 70.0f;
   s.media[0].densityScale = 1.5f;
@@ -121,8 +125,10 @@ TEST_F(GpuPathTracer, FeatureSetsCompileDifferentVariantsAndBothMatch) {
   multi.render.maxBounces = 8;
   const uint64_t compilesBefore = compiler().compiles();
   std::string v1, v2;
-  renderAndCompare(ctx(), compiler(), single, grid, 256, 512, "variant_single", &v1);
-  renderAndCompare(ctx(), compiler(), multi, grid, 256, 512, "variant_multi", &v2);
+  // 512 and 1024 samples: the sun-only image is noisier than its size suggests (a single bounce
+  // with no sky); with 256 and 512 its aggregate test resolves only a 2.7% bias.
+  renderAndCompare(ctx(), compiler(), single, grid, 512, 1024, "variant_single", &v1);
+  renderAndCompare(ctx(), compiler(), multi, grid, 512, 1024, "variant_multi", &v2);
   EXPECT_EQ(v1, "sun");
   EXPECT_EQ(v2, "sun+env+multi");
   EXPECT_EQ(compiler().compiles() - compilesBefore, 2u);
