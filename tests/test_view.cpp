@@ -28,8 +28,10 @@ std::string quote(const std::string& s) { return "'" + s + "'"; }
 // Runs `plume view ARGS` under a virtual X server; returns the exit code, output in `log`.
 int runView(const std::vector<std::string>& args, std::string& log) {
   // Validation layers on: a synchronisation or layout error in the swapchain path fails the test.
-  std::string cmd = "PLUME_VALIDATION=1 xvfb-run -a -s '-screen 0 1024x768x24' " + quote(PLUME_EXE) + " view";
-  for (const auto& a : args) cmd += " " + quote(a);
+  std::string cmd = "PLUME_VALIDATION=1 xvfb-run -a -s '-screen 0 1024x768x24' ";
+  cmd += quote(PLUME_EXE);
+  cmd += " view";
+  for (const auto& a : args) cmd.append(" ").append(quote(a));
   cmd += " 2>&1";
   FILE* pipe = popen(cmd.c_str(), "r");
   if (!pipe) return -1;

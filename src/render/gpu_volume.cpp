@@ -8,9 +8,15 @@
 
 namespace plume {
 
+namespace {
+uint64_t newSerial() {
+  static std::atomic<uint64_t> next{1};
+  return next++;
+}
+}  // namespace
+
 GpuVolumeResources::GpuVolumeResources(gpu::Context& ctx, const BakedVolume& bake, float densityScale) {
-  static std::atomic<uint64_t> nextSerial{1};
-  serial_ = nextSerial++;
+  serial_ = newSerial();
   using namespace shared;
   const bool empty = bake.empty();
   params_.worldToIndex = bake.worldToIndex;
@@ -70,6 +76,13 @@ GpuVolumeResources::GpuVolumeResources(gpu::Context& ctx, const BakedVolume& bak
   counters_ = gpu::Buffer(ctx, 16, storage, "tracking counters");
   resetCounters();
   bytes_ = sizeof(params_) + atlasBytes + bake.indirection.size() * 4 + majorants.size() * 4 + coarse.size() * 4;
+}
+
+void GpuVolumeResources::setDensityScale(float densityScale) {
+  if (params_.boundsMin.w == densityScale) return;
+  params_.boundsMin.w = densityScale;
+  paramBuffer_.upload(&params_, sizeof(params_));
+  serial_ = newSerial();  // another medium: renderers must not take it for the one they rendered
 }
 
 void GpuVolumeResources::bind(gpu::DescriptorSet& set) const {

@@ -25,6 +25,9 @@ class GpuVolumeResources {
   void bindAsPrevious(gpu::DescriptorSet& set, uint32_t params, uint32_t atlas, uint32_t indirection,
                       uint32_t coarse) const;
   const shared::GpuVolume& params() const { return params_; }
+  // Changes the density scale in place (one small upload; the atlas and fields stay). The volume
+  // then counts as a new one (serial). Not while a submitted pass still reads it.
+  void setDensityScale(float densityScale);
   uint64_t deviceBytes() const { return bytes_; }
   bool hasMeanField() const { return hasMeanField_; }  // ReSTIR needs it (BakeOptions::meanField)
   // Unique per constructed volume in this process (never reused), so a renderer can tell that

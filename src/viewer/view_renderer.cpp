@@ -90,12 +90,13 @@ const BakedVolume& VolumeCache::bake(int frame) {
 }
 
 const GpuVolumeResources& VolumeCache::volume(int frame, float densityScale) {
-  if (!current_ || medium_.vdbPath(frame) != currentPath_ || densityScale != currentScale_) {
+  if (!current_ || medium_.vdbPath(frame) != currentPath_) {
     const BakedVolume& b = bake(frame);
     current_.reset();  // free the old device copy first
     current_ = std::make_unique<GpuVolumeResources>(ctx_, b, densityScale);
     currentPath_ = medium_.vdbPath(frame);
-    currentScale_ = densityScale;
+  } else {
+    current_->setDensityScale(densityScale);  // the density slider: no re-upload of the grid
   }
   return *current_;
 }

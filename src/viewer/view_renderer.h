@@ -53,7 +53,8 @@ std::unique_ptr<ViewRenderer> makeViewRenderer(gpu::Context& ctx, gpu::ShaderCom
 class VolumeCache {
  public:
   VolumeCache(gpu::Context& ctx, const Medium& medium, BakeOptions options) : ctx_(ctx), medium_(medium), options_(options) {}
-  // The device volume for `frame` with `densityScale`; rebuilt only when either changed.
+  // The device volume for `frame` with `densityScale`: rebuilt when the frame's file changes, its
+  // density scale set in place otherwise.
   const GpuVolumeResources& volume(int frame, float densityScale);
   const BakedVolume& bake(int frame);
 
@@ -64,7 +65,6 @@ class VolumeCache {
   std::map<std::string, BakedVolume> bakes_;  // by file
   std::unique_ptr<GpuVolumeResources> current_;
   std::string currentPath_;
-  float currentScale_ = -1.0f;
 };
 
 }  // namespace plume::viewer

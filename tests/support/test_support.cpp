@@ -54,7 +54,7 @@ std::string shellQuote(const std::string& s) {
 
 RunResult runPlume(const std::vector<std::string>& args) {
   std::string cmd = shellQuote(PLUME_EXE);
-  for (const auto& a : args) cmd += " " + shellQuote(a);
+  for (const auto& a : args) cmd.append(" ").append(shellQuote(a));
   cmd += " 2>&1";
   RunResult result;
   FILE* pipe = popen(cmd.c_str(), "r");
