@@ -1,11 +1,13 @@
 // Tests of src/core/stats: the incomplete gamma and normal functions against known values, the
 // chi-square helper (accepts the right distribution, rejects a slightly wrong one, pools small
 // bins), relMSE, and the per-pixel Z-tests (pass for two independent estimates of the same
-// image, fail for a bias of a few standard errors in a region). Fixed seeds.
+// image, fail for a bias of a few standard errors in a region); the shaders' running mean and
+// variance (shared/accumulate.h). Fixed seeds.
 #include "core/error.h"
 #include "core/stats.h"
 #include "support/test_support.h"
 
+#include "shaders/shared/accumulate.h"
 #include "shaders/shared/rng.h"
 
 #include <gtest/gtest.h>
@@ -264,4 +266,42 @@ TEST(Stats, ZTestRefusesBadInput) {
   EXPECT_THROW(zTest(a, c), InputError);
   EXPECT_THROW(zTestAgainst(c, glm::vec3(1.0f)), InputError);
   EXPECT_THROW(zTestAgainst(a, std::vector<float>(5)), InputError);
+}
+
+// The renderers' accumulation (shared/accumulate.h): samples merged one at a time (ReSTIR's
+// shading) or in batches (the path tracer) give the two-pass mean and M2.
+TEST(Stats, AccumulationMergesMatchTwoPassMeanAndVariance) {
+  std::vector<glm::vec3> x;
+  uint32_t h = 12345u;
+  for (int i = 0; i < 100; ++i) {
+    glm::vec3 v;
+    for (int c = 0; c < 3; ++c) {
+      h = h * 1664525u + 1013904223u;
+      v[c] = float(h >> 8) / float(1u << 24) * float(c + 1) + 10.0f;
+    }
+    x.push_back(v);
+  }
+  glm::dvec3 mean(0.0), m2(0.0);
+  for (const glm::vec3& v : x) mean += glm::dvec3(v) / double(x.size());
+  for (const glm::vec3& v : x) m2 += (glm::dvec3(v) - mean) * (glm::dvec3(v) - mean);
+  glm::vec4 one(0.0f), batched(0.0f);
+  glm::vec3 m2One(0.0f), m2Batched(0.0f);
+  for (const glm::vec3& v : x) shared::acc_merge(one, m2One, v, glm::vec3(0.0f), 1.0f);
+  for (size_t b = 0; b < x.size(); b += 16) {  // batches of 16 (the last one 4)
+    glm::vec4 batch(0.0f);
+    glm::vec3 m2Batch(0.0f);
+    for (size_t i = b; i < std::min(x.size(), b + 16); ++i) shared::acc_merge(batch, m2Batch, x[i], glm::vec3(0.0f), 1.0f);
+    shared::acc_merge(batched, m2Batched, glm::vec3(batch), m2Batch, batch.w);
+  }
+  for (const auto& [acc, accM2] : {std::pair{one, m2One}, std::pair{batched, m2Batched}}) {
+    EXPECT_EQ(acc.w, 100.0f);
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(acc[c], mean[c], 1e-5 * mean[c]) << c;
+      EXPECT_NEAR(accM2[c], m2[c], 1e-4 * m2[c]) << c;
+    }
+  }
+  glm::vec4 empty(0.0f);
+  glm::vec3 m2Empty(0.0f);
+  shared::acc_merge(empty, m2Empty, glm::vec3(1.0f), glm::vec3(0.0f), 0.0f);  // nothing to add
+  EXPECT_EQ(empty, glm::vec4(0.0f));
 }

@@ -8,6 +8,7 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
+#include "../shared/accumulate.h"
 #include "../shared/gpu_types.h"
 #include "../volume/bindings.glsl"
 
@@ -72,7 +73,7 @@ void main() {
   uvec2 pixel = gl_GlobalInvocationID.xy;
   if (pixel.x >= frame.image.x || pixel.y >= frame.image.y) return;
   uint index = pixel.y * frame.image.x + pixel.x;
-  vec3 mean = vec3(0.0f);
+  vec4 batch = vec4(0.0f);  // (mean, n) of this dispatch's samples, and their M2
   vec3 m2 = vec3(0.0f);
   for (uint s = 0u; s < frame.image.z; ++s) {
     uint sampleIndex = frame.seeds.z + s;
@@ -83,18 +84,12 @@ void main() {
     float sy = (1.0f - 2.0f * (float(pixel.y) + u.y) / float(frame.image.y)) * frame.camPosition.w;
     vec3 dir = normalize(frame.camForward.xyz + sx * frame.camRight.xyz + sy * frame.camUp.xyz);
     vec3 L = tracePath(frame.camPosition.xyz, dir, rng);
-    // Welford update within the batch.
-    vec3 delta = L - mean;
-    mean += delta / float(s + 1u);
-    m2 += delta * (L - mean);
+    acc_merge(batch, m2, L, vec3(0.0f), 1.0f);
   }
-  // Chan's merge of (n_a, mean_a, M2_a) with this batch (n_b, mean_b, M2_b).
+  // The batch into the accumulation.
   vec4 a = accum[2u * index];
   vec3 m2a = accum[2u * index + 1u].rgb;
-  float na = a.w;
-  float nb = float(frame.image.z);
-  float n = na + nb;
-  vec3 d = mean - a.rgb;
-  accum[2u * index] = vec4(a.rgb + d * (nb / n), n);
-  accum[2u * index + 1u] = vec4(m2a + m2 + d * d * (na * nb / n), 0.0f);
+  acc_merge(a, m2a, batch.rgb, m2, batch.w);
+  accum[2u * index] = a;
+  accum[2u * index + 1u] = vec4(m2a, 0.0f);
 }

@@ -10,6 +10,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 #include "../restir/coarse.glsl"
 #include "../restir/bridge.glsl"
 #include "../restir/shade.glsl"
+#include "../shared/accumulate.h"
 
 void main() {
   uvec2 pixel = gl_GlobalInvocationID.xy;
@@ -21,10 +22,9 @@ void main() {
     rsOutput[2u * index + 1u] = vec4(0.0f);
     return;
   }
-  vec4 a = rsOutput[2u * index];  // Welford's update with one sample
-  float n = a.w + 1.0f;
-  vec3 d = L - a.rgb;
-  vec3 mean = a.rgb + d / n;
-  rsOutput[2u * index] = vec4(mean, n);
-  rsOutput[2u * index + 1u] = vec4(rsOutput[2u * index + 1u].rgb + d * (L - mean), 0.0f);
+  vec4 a = rsOutput[2u * index];
+  vec3 m2 = rsOutput[2u * index + 1u].rgb;
+  acc_merge(a, m2, L, vec3(0.0f), 1.0f);
+  rsOutput[2u * index] = a;
+  rsOutput[2u * index + 1u] = vec4(m2, 0.0f);
 }
