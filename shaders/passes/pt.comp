@@ -80,9 +80,8 @@ void main() {
     RngState rng = rng_init(pixel, frame.seeds.y, RNG_STREAM_PATH + (sampleIndex << 8u), frame.seeds.x);
     vec2 u = rng_float2(rng);
     // Box filter, row 0 at the top (DESIGN §2).
-    float sx = (2.0f * (float(pixel.x) + u.x) / float(frame.image.x) - 1.0f) * frame.camPosition.w * frame.camForward.w;
-    float sy = (1.0f - 2.0f * (float(pixel.y) + u.y) / float(frame.image.y)) * frame.camPosition.w;
-    vec3 dir = normalize(frame.camForward.xyz + sx * frame.camRight.xyz + sy * frame.camUp.xyz);
+    vec3 dir = normalize(cam_direction(vec2(pixel) + u, frame.image.xy, frame.camPosition, frame.camForward,
+                                       frame.camRight, frame.camUp));
     vec3 L = tracePath(frame.camPosition.xyz, dir, rng);
     acc_merge(batch, m2, L, vec3(0.0f), 1.0f);
   }

@@ -24,11 +24,9 @@ struct RsDomain {
 };
 
 RsDomain rs_camera_domain(uvec2 pixel, vec4 pos, vec4 fwd, vec4 right, vec4 up, uint v) {
-  float sx = (2.0f * float(pixel.x) / float(frame.image.x) - 1.0f) * pos.w * fwd.w;
-  float sy = (1.0f - 2.0f * float(pixel.y) / float(frame.image.y)) * pos.w;
   RsDomain D;
   D.origin = pos.xyz;
-  D.corner = fwd.xyz + sx * right.xyz + sy * up.xyz;
+  D.corner = cam_direction(vec2(pixel), frame.image.xy, pos, fwd, right, up);
   D.du = (2.0f / float(frame.image.x)) * pos.w * fwd.w * right.xyz;
   D.dv = (-2.0f / float(frame.image.y)) * pos.w * up.xyz;
   D.v = v;

@@ -98,9 +98,8 @@ void rs_reuse(uint outSet, uint outPixel, inout RngState rng) {
 // cameras only, never on a sample. False when it falls outside the previous image.
 bool rs_reproject(uvec2 pixel, out uvec2 prevPixel) {
   prevPixel = pixel;
-  float sx = (2.0f * (float(pixel.x) + 0.5f) / float(frame.image.x) - 1.0f) * frame.camPosition.w * frame.camForward.w;
-  float sy = (1.0f - 2.0f * (float(pixel.y) + 0.5f) / float(frame.image.y)) * frame.camPosition.w;
-  vec3 dir = normalize(frame.camForward.xyz + sx * frame.camRight.xyz + sy * frame.camUp.xyz);
+  vec3 dir = normalize(cam_direction(vec2(pixel) + 0.5f, frame.image.xy, frame.camPosition, frame.camForward,
+                                     frame.camRight, frame.camUp));
   vec3 p = frame.camPosition.xyz + rsp.configF.z * dir - rsp.prevCamPosition.xyz;
   float z = dot(p, rsp.prevCamForward.xyz);
   if (!(z > 0.0f)) return false;

@@ -50,6 +50,14 @@ struct GpuFrame {
   uvec4 lights;      // x: light count
 };
 
+// The pinhole camera's (un-normalised) direction through image position p, in pixels from the
+// image's top-left corner (row 0 at the top, DESIGN §2), for a camera in GpuFrame's layout.
+PLUME_FN vec3 cam_direction(vec2 p, uvec2 image, vec4 pos, vec4 fwd, vec4 right, vec4 up) {
+  float sx = (2.0f * p.x / float(image.x) - 1.0f) * pos.w * fwd.w;
+  float sy = (1.0f - 2.0f * p.y / float(image.y)) * pos.w;
+  return vec3(fwd) + sx * vec3(right) + sy * vec3(up);
+}
+
 PLUME_NS_END
 
 #ifdef __cplusplus
