@@ -200,25 +200,24 @@ float rs_residual_tr(vec3 xWorld, vec3 wWorld, float tMax, inout RngState rng) {
   RsWalk w;
   if (!rs_walk_start(0u, o, d, tMax, w)) return 1.0f;
   float scale = rsv_scale(0u);
-  float tau = 0.0f;
-  float prod = 1.0f;
+  float tr = 1.0f;  // the estimate so far: exp(-tau_mean) times the residual factors
   float a;
   float b;
   uint i;
-  while (prod != 0.0f && rs_walk_next(w, a, b, i)) {
+  while (tr != 0.0f && rs_walk_next(w, a, b, i)) {
     vec2 field = rs_mean_field(i);
     float mean = scale * field.x;
-    tau += mean * (b - a);
+    tr *= exp(-mean * (b - a));
     float mu = PLUME_RS_RESIDUAL_SCALE * scale * field.y;
     if (!(mu > 0.0f)) continue;
     float t = a;
     for (;;) {
       t -= log(1.0f - rng_float(rng)) / mu;
       if (!(t < b)) break;
-      prod *= 1.0f - (scale * rsv_density(0u, o + t * d) - mean) / mu;
+      tr *= 1.0f - (scale * rsv_density(0u, o + t * d) - mean) / mu;
     }
   }
-  return exp(-tau) * prod;
+  return tr;
 }
 
 #endif

@@ -160,7 +160,21 @@ bool vol_sample_collision(vec3 oWorld, vec3 dWorld, float tMax, inout RngState r
   return false;
 }
 
-// Ratio tracking: an unbiased estimate of the transmittance over (0, tMax).
+// Russian roulette on a transmittance estimate (unbiased): below VOL_RR_TRANSMITTANCE it
+// survives with probability |T| / VOL_RR_TRANSMITTANCE and is raised to that value, so an
+// estimate that can only add a little stops early instead of walking through the rest of a dense
+// medium, and a survivor's weight stays bounded.
+const float VOL_RR_TRANSMITTANCE = 0.01f;
+bool vol_transmittance_roulette(inout float tr, inout RngState rng) {
+  float m = abs(tr);
+  if (!(m < VOL_RR_TRANSMITTANCE)) return true;
+  if (rng_float(rng) * VOL_RR_TRANSMITTANCE >= m) return false;
+  tr = tr < 0.0f ? -VOL_RR_TRANSMITTANCE : VOL_RR_TRANSMITTANCE;
+  return true;
+}
+
+// Ratio tracking: an unbiased estimate of the transmittance over (0, tMax), with Russian
+// roulette once it is small (vol_transmittance_roulette).
 float vol_ratio_tracking(vec3 oWorld, vec3 dWorld, float tMax, inout RngState rng) {
   vec3 o;
   vec3 d;
@@ -183,6 +197,7 @@ float vol_ratio_tracking(vec3 oWorld, vec3 dWorld, float tMax, inout RngState rn
       t -= log(1.0f - rng_float(rng)) / maj;
       if (t >= b) break;
       tr *= max(0.0f, 1.0f - vol_sigma_t(o + t * d) / maj);
+      if (!vol_transmittance_roulette(tr, rng)) return 0.0f;
     }
   }
   return tr;
