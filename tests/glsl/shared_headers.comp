@@ -7,6 +7,7 @@
 #extension GL_GOOGLE_include_directive : require
 
 #include "shared/common.h"
+#include "shared/accumulate.h"
 #include "shared/rng.h"
 #include "shared/phase.h"
 #include "shared/sampling.h"
@@ -72,6 +73,12 @@ void main() {
     dda_next(dda, t0, t1, cell);
   }
   s += vec3(cell) * (t1 - t0) + frame.albedo.xyz + lights[0].emission.xyz;
+  s += cam_direction(vec2(0.5f), frame.image.xy, frame.camPosition, frame.camForward, frame.camRight, frame.camUp);
+  // accumulate.h
+  vec4 acc = vec4(0.0f);
+  vec3 m2 = vec3(0.0f);
+  acc_merge(acc, m2, s, vec3(0.0f), 1.0f);
+  s += acc.xyz + m2;
   // restir_types.h
   vec3 wd = rs_decode_dir(rs_encode_dir(wo));
   float mis = rs_pairwise_neighbour(1.0f, p, 2.0f, pc, 3.0f) + rs_pairwise_canonical_term(1.0f, p, 2.0f, pc, 3.0f) +
