@@ -3,6 +3,8 @@
 #include "core/error.h"
 
 #include <cstdio>
+#include <exception>
+#include <new>
 
 int main(int argc, char** argv) {
   using namespace plume;
@@ -35,6 +37,13 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "plume: device error: %s\n", e.what());
     return kExitDeviceFailure;
   } catch (const InternalError& e) {
+    std::fprintf(stderr, "plume: internal error: %s\n", e.what());
+    return kExitInternal;
+  } catch (const std::bad_alloc&) {
+    // Host memory, like device memory, is the machine's: another one may have enough.
+    std::fprintf(stderr, "plume: device error: out of host memory\n");
+    return kExitDeviceFailure;
+  } catch (const std::exception& e) {  // not plume's own: a bug or a library's failure, never retried
     std::fprintf(stderr, "plume: internal error: %s\n", e.what());
     return kExitInternal;
   }
