@@ -151,7 +151,7 @@ RestirRun runRestir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scen
       const size_t cur = spec.animatedGrid ? size_t(f) : 0, prev = spec.animatedGrid && f > 0 ? size_t(f - 1) : cur;
       restir.setVolumes(*volumes[cur], *volumes[prev]);
       last = restir.renderFrame(spec.firstFrame + f, uint32_t(run + 1) + sequenceOffset);
-      out.dropped += restir.lastDroppedCount();
+      out.dropped += restir.takeDroppedCount();
     }
     acc.add(last);
   }

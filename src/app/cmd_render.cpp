@@ -128,13 +128,13 @@ class RestirFrames final : public FrameEstimator {
     // 0.00058 (notes/restir.md).
     const int spp = scene_.render.spp, settle = spp / 8;
     averaged_ = spp - settle;
-    dropped_ = 0;
+    restir_.takeDroppedCount();  // counted from here: this frame's iterations
     for (int i = 0; i < spp; ++i) {
       if (i == 1) restir_.setVolumes(volume, volume);
       restir_.render(frame, 0, uint32_t(i), i > settle);
-      dropped_ += restir_.lastDroppedCount();
       samplesDone(1);
     }
+    dropped_ = restir_.takeDroppedCount();
     hasHistory_ = true;
   }
   Image readImage() const override { return restir_.readImage(); }

@@ -123,6 +123,7 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   bounces_ = gpu::Buffer(ctx, kSets * pixels * stride * sizeof(glm::vec4), storage, "reservoir path vertices");
   output_ = gpu::Buffer(ctx, 2 * pixels * sizeof(glm::vec4), storage, "restir accumulation");
   counters_ = gpu::Buffer(ctx, 16, storage, "restir counters");
+  counters_.fillZero();
   reservoirs_.fillZero();
   paths_.fillZero();
   for (gpu::ComputePass* p : {candidates_.get(), temporal_.get(), spatial_.get(), shade_.get()}) {
@@ -196,8 +197,6 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
   const uint32_t key = uint32_t(frame) * kMaxIterations + iteration;
   fillFrame(frame, sequence, key);
   const bool temporal = params_.frames.z != 0u;
-  const uint32_t zero[4] = {0, 0, 0, 0};
-  counters_.upload(zero, sizeof zero);
   const glm::uvec3 items(uint32_t(scene_.camera.width), uint32_t(scene_.camera.height), 1u);
   std::vector<std::string> labels;
   uint32_t finalSet = 0;
@@ -238,9 +237,14 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
   history_ = finalSet;
   hasHistory_ = true;
   prevSequence_ = sequence;
+}
+
+uint32_t Restir::takeDroppedCount() {
   uint32_t counters[4];
   counters_.download(counters, sizeof counters);
-  dropped_ = counters[0];
+  const uint32_t zero[4] = {0, 0, 0, 0};
+  counters_.upload(zero, sizeof zero);
+  return counters[0];
 }
 
 double Restir::lastFrameGpuMs() const {

@@ -62,8 +62,9 @@ class Restir {
   const gpu::Buffer& accumulation() const { return output_; }
   const PassTimes& lastPassTimes() const { return passTimes_; }
   double lastFrameGpuMs() const;
-  // Reservoir unpacks whose non-finite weights were dropped in the last frame (DESIGN §4.2.3).
-  uint32_t lastDroppedCount() const { return dropped_; }
+  // Reservoir unpacks whose non-finite weights were dropped since the last call (DESIGN §4.2.3):
+  // the passes count on the device; one read-back when asked, not one per iteration.
+  uint32_t takeDroppedCount();
 
  private:
   void fillFrame(int frame, uint32_t sequence, uint32_t key);
@@ -85,7 +86,6 @@ class Restir {
   glm::vec4 prevCam_[4]{};
   glm::vec3 centre_{0.0f};  // world centre of the volume's bounds (reprojection depth)
   PassTimes passTimes_;
-  uint32_t dropped_ = 0;
 };
 
 }  // namespace plume
