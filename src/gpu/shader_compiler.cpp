@@ -1,6 +1,7 @@
 #include "gpu/shader_compiler.h"
 
 #include "core/error.h"
+#include "core/hash.h"
 #include "core/log.h"
 
 #include <glslang/Public/ResourceLimits.h>
@@ -29,15 +30,6 @@ void initGlslang() {
     glslang::InitializeProcess();
     std::atexit([] { glslang::FinalizeProcess(); });
   });
-}
-
-uint64_t fnv1a(const std::string& s) {
-  uint64_t h = 1469598103934665603ULL;
-  for (unsigned char c : s) {
-    h ^= c;
-    h *= 1099511628211ULL;
-  }
-  return h;
 }
 
 std::string slurp(const fs::path& p) {

@@ -1,6 +1,7 @@
 #include "render/bench.h"
 
 #include "core/error.h"
+#include "core/hash.h"
 #include "core/log.h"
 #include "core/stats.h"
 #include "media/vdb_loader.h"
@@ -86,9 +87,7 @@ uint64_t referenceKey(const Scene& s, int gridFrame) {
   const auto time = fs::last_write_time(vdb, ec).time_since_epoch().count();
   key += strf("|%s|%llu|%lld|%d|%d", vdb.string().c_str(), (unsigned long long)size, (long long)time,
               s.render.maxBounces, s.render.rrStartBounce);
-  uint64_t h = 1469598103934665603ull;  // FNV-1a: stable across runs and builds
-  for (unsigned char c : key) h = (h ^ c) * 1099511628211ull;
-  return h;
+  return fnv1a(key);
 }
 
 // The reference of `frame` (the GPU path tracer at refSpp), cached next to the scene.
