@@ -6,15 +6,14 @@
 #include "core/stats.h"
 #include "media/vdb_loader.h"
 #include "render/path_tracer.h"
+#include "scene/render_key.h"
 
 #include <glm/glm.hpp>
-#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <map>
 #include <memory>
 
@@ -62,32 +61,20 @@ void makeFolder(const fs::path& dir) {
   if (ec) throw InputError("bench: cannot create " + dir.string() + ": " + ec.message());
 }
 
-// What the reference's pixels depend on besides its file name's fields: the scene file's content
-// less the render settings a reference does not use (mode, spp, seed, frames, the ReSTIR knobs),
-// the grid file's size and time, the path length settings. An edited scene or a re-baked grid gets
-// a new reference, never a stale one; tuning ReSTIR in the scene file keeps the cached one.
+// What the reference's pixels depend on besides its file name's fields: the path tracer's render
+// key of the frame whose grid is held still (scene/render_key.h: camera, media, lights, every
+// render setting the path tracer reads; not mode, spp, seed or the ReSTIR settings), and the
+// grid file's size and time. An edited scene or a re-baked grid gets a new reference, never a
+// stale one; tuning ReSTIR in the scene file keeps the cached one.
 uint64_t referenceKey(const Scene& s, int gridFrame) {
-  std::ifstream in(s.path, std::ios::binary);
-  std::string key;
-  try {
-    nlohmann::json j = nlohmann::json::parse(in);
-    if (j.contains("render") && j["render"].is_object()) {
-      nlohmann::json& r = j["render"];
-      for (const char* unused : {"mode", "spp", "seed", "frames"}) r.erase(unused);
-      for (auto it = r.begin(); it != r.end();) it = it.key().rfind("restir_", 0) == 0 ? r.erase(it) : std::next(it);
-    }
-    key = j.dump();
-  } catch (const nlohmann::json::exception&) {
-    in.clear(), in.seekg(0);
-    key.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  }
+  const RenderKey render = sceneRenderKey(s, gridFrame, [](const std::string& k) {
+    return k != "mode" && k != "spp" && k != "seed" && k.rfind("restir_", 0) != 0;
+  });
   std::error_code ec;
   const fs::path vdb = s.media.at(0).vdbPath(gridFrame);
   const auto size = fs::file_size(vdb, ec);
   const auto time = fs::last_write_time(vdb, ec).time_since_epoch().count();
-  key += strf("|%s|%llu|%lld|%d|%d", vdb.string().c_str(), (unsigned long long)size, (long long)time,
-              s.render.maxBounces, s.render.rrStartBounce);
-  return fnv1a(key);
+  return fnv1a(render.text() + strf("|%llu|%lld", (unsigned long long)size, (long long)time));
 }
 
 // The reference of `frame` (the GPU path tracer at refSpp), cached next to the scene.
