@@ -21,7 +21,6 @@ void rs_generate_candidates(uvec2 pixel, uint pixelIndex, uint outSet) {
   uint maxVertices = min(frame.image.w, RS_MAX_VERTICES);
   float g = frame.albedo.w;
   float q = min(1.0f, plume_max3(frame.albedo.rgb));
-
   uint base = rs_bounce_base(outSet, pixelIndex);
   RsReservoir r = rs_empty();
   RsPathHead head;
