@@ -1,4 +1,4 @@
-// Volumetric ReSTIR (DESIGN §4.2, §7). Tier b: the MIS weights of reuse sum to 1. Tier d: the
+// Volumetric ReSTIR (DESIGN §4.2, §7); its MIS weights: tests/test_restir_mis.cpp. Tier d: the
 // ReSTIR estimator against the independent CPU reference, per-pixel Z-test with a Šidák
 // correction and an aggregate z-test on the image mean (support/reference_check.h), validation
 // layers on: candidates and final shading alone; spatial reuse (pairwise MIS and the generalised
@@ -193,51 +193,6 @@ void expectMatches(const RestirRun& run, const Image& ref, const std::string& na
 
 }  // namespace
 
-// --- Tier b: MIS weights --------------------------------------------------------------------
-
-TEST(RestirMis, PairwiseAndGbhWeightsSumToOne) {
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<float> U(0.0f, 1.0f);
-  for (int trial = 0; trial < 1000; ++trial) {
-    const int k = 1 + trial % 5;
-    std::vector<float> M(k + 1), ph(k + 1);  // confidence and p̂ of one path in each domain
-    for (int i = 0; i <= k; ++i) {
-      M[i] = 1.0f + float(trial % 7) * U(rng);
-      ph[i] = U(rng) < 0.2f ? 0.0f : U(rng);  // failed shifts included
-    }
-    if (ph[0] == 0.0f) ph[0] = 0.5f;  // a canonical-domain path
-    float Msum = 0;
-    for (float m : M) Msum += m;
-    // Pairwise: the canonical technique plus each neighbour's, for the same path x.
-    float mc = M[0] / Msum, total = 0;
-    for (int i = 1; i <= k; ++i) {
-      mc += shared::rs_pairwise_canonical_term(M[i], ph[i], M[0], ph[0], Msum);
-      total += shared::rs_pairwise_neighbour(M[i], ph[i], M[0], ph[0], Msum);
-    }
-    EXPECT_NEAR(mc + total, 1.0f, 1e-5f);
-    float denom = 0, gbh = 0;
-    for (int i = 0; i <= k; ++i) denom += M[i] * ph[i];
-    for (int i = 0; i <= k; ++i) gbh += shared::rs_gbh(M[i], ph[i], denom);
-    EXPECT_NEAR(gbh, 1.0f, 1e-5f);
-    // Sums to 1 hold for any share function; the share itself is the pair's balance heuristic,
-    // written out here, 0 when neither technique can produce the path.
-    for (int i = 1; i <= k; ++i) {
-      const float a = M[i] * ph[i], d = a + M[0] * ph[0];
-      EXPECT_NEAR(shared::rs_pair_share(M[i], ph[i], M[0], ph[0]), d > 0 ? a / d : 0.0f, 1e-6f);
-    }
-    EXPECT_EQ(shared::rs_pair_share(2.0f, 0.0f, 3.0f, 0.0f), 0.0f);
-  }
-}
-
-TEST(RestirMis, LightDirectionEncodingRoundTrips) {
-  std::mt19937 rng(3);
-  std::normal_distribution<float> N;
-  for (int i = 0; i < 1000; ++i) {
-    glm::vec3 w = glm::normalize(glm::vec3(N(rng), N(rng), N(rng)));
-    glm::vec3 back = shared::rs_decode_dir(shared::rs_encode_dir(w));
-    EXPECT_LT(glm::length(back - w), 1e-5f);
-  }
-}
 
 // --- Tier d: images against the CPU reference -------------------------------------------------
 

@@ -1,17 +1,15 @@
-// ReSTIR pass 1 (DESIGN §4.2 step 1): M candidate paths per pixel into reservoir set push.sets.z.
+// ReSTIR pass 1 (DESIGN §4.2 step 1): M candidate paths per pixel into reservoir set push.outSet.
 #version 450
 #extension GL_GOOGLE_include_directive : require
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
 #include "../restir/bindings.glsl"
-#include "../volume/volume.glsl"
-#include "../restir/coarse.glsl"
 #include "../restir/bridge.glsl"
 #include "../restir/candidates.glsl"
 
 void main() {
   uvec2 pixel = gl_GlobalInvocationID.xy;
-  if (pixel.x >= frame.image.x || pixel.y >= frame.image.y) return;
-  rs_generate_candidates(pixel, pixel.y * frame.image.x + pixel.x, push.sets.z);
+  if (pixel.x >= frame.size.x || pixel.y >= frame.size.y) return;
+  rs_generate_candidates(pixel, pixel.y * frame.size.x + pixel.x, push.outSet);
 }

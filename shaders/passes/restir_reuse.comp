@@ -1,15 +1,13 @@
 // ReSTIR passes 2 and 3 (DESIGN §4.2 steps 5-6): temporal reuse (PLUME_RS_TEMPORAL 1: the
-// canonical set push.sets.x and the history set push.sets.y at the
-// reprojected pixel, confidence capped) or one spatial round (k neighbours of set push.sets.x
-// within the radius, drawn from the pixel and the round only). Output: set push.sets.z.
+// canonical set push.inSet and the history set push.historySet at the
+// reprojected pixel, confidence capped) or one spatial round (k neighbours of set push.inSet
+// within the radius, drawn from the pixel and the round only). Output: set push.outSet.
 #version 450
 #extension GL_GOOGLE_include_directive : require
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
 #include "../restir/bindings.glsl"
-#include "../volume/volume.glsl"
-#include "../restir/coarse.glsl"
 #include "../restir/bridge.glsl"
 #include "../restir/reuse.glsl"
 
@@ -21,7 +19,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 // pipeline holds only its own code (see restir/reuse.glsl on PLUME_RS_MIS).
 void main() {
   uvec2 pixel = gl_GlobalInvocationID.xy;
-  if (pixel.x >= frame.image.x || pixel.y >= frame.image.y) return;
-  rs_reuse_pixel(pixel, pixel.y * frame.image.x + pixel.x, PLUME_RS_TEMPORAL != 0, push.misc.x, push.sets.x,
-                 push.sets.y, push.sets.z);
+  if (pixel.x >= frame.size.x || pixel.y >= frame.size.y) return;
+  rs_reuse_pixel(pixel, pixel.y * frame.size.x + pixel.x, PLUME_RS_TEMPORAL != 0, push.spatialRound, push.inSet,
+                 push.historySet, push.outSet);
 }

@@ -1,23 +1,21 @@
-// ReSTIR pass 4 (DESIGN §4.2 step 7): final shading of reservoir set push.sets.x, accumulated into
-// the output (push.misc.y = 1: the first sample of the accumulation, which restarts it).
+// ReSTIR pass 4 (DESIGN §4.2 step 7): final shading of reservoir set push.inSet, accumulated into
+// the output (push.restartAccumulation = 1: the first sample of the accumulation, which restarts it).
 #version 450
 #extension GL_GOOGLE_include_directive : require
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
 #include "../restir/bindings.glsl"
-#include "../volume/volume.glsl"
-#include "../restir/coarse.glsl"
 #include "../restir/bridge.glsl"
 #include "../restir/shade.glsl"
 #include "../shared/accumulate.h"
 
 void main() {
   uvec2 pixel = gl_GlobalInvocationID.xy;
-  if (pixel.x >= frame.image.x || pixel.y >= frame.image.y) return;
-  uint index = pixel.y * frame.image.x + pixel.x;
-  vec3 L = rs_shade(pixel, index, push.sets.x);
-  if (push.misc.y != 0u) {
+  if (pixel.x >= frame.size.x || pixel.y >= frame.size.y) return;
+  uint index = pixel.y * frame.size.x + pixel.x;
+  vec3 L = rs_shade(pixel, index, push.inSet);
+  if (push.restartAccumulation != 0u) {
     rsOutput[2u * index] = vec4(L, 1.0f);
     rsOutput[2u * index + 1u] = vec4(0.0f);
     return;

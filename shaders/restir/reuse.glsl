@@ -2,7 +2,7 @@
 // canonical reservoir (index 0, always included) and neighbours, each with its own domain, are
 // resampled into the canonical domain with the volume-aware shift (the path's coordinates
 // copied, so Jacobian 1; a shift onto zero density gives p̂ = 0, a failure, and the MIS weights
-// see the same zero from either side) and MIS weights from shared/restir_types.h:
+// see the same zero from either side) and MIS weights from shared/restir_mis.h:
 //   w_s = m_s(y_s) * p̂_c(y_s) * W_s,   W = Σ w / p̂_c(Y)   (GRIS Eq. 3.2-3.3).
 // Requires restir/bridge.glsl.
 #ifndef PLUME_RESTIR_REUSE_GLSL
@@ -30,7 +30,7 @@ RsInputs in_;
 uint rs_input_set(uint j) { return (j == 1u && in_.history) ? in_.historySet : in_.set; }
 
 RsDomain rs_input_domain(uint j) {
-  uvec2 p = uvec2(in_.pixel[j] % frame.image.x, in_.pixel[j] / frame.image.x);
+  uvec2 p = uvec2(in_.pixel[j] % frame.size.x, in_.pixel[j] / frame.size.x);
   return (j == 1u && in_.history) ? rs_previous_domain(p) : rs_current_domain(p);
 }
 
@@ -48,36 +48,25 @@ float rs_target_in(uint s, uint j) {
 #ifndef PLUME_RS_MIS
 #define PLUME_RS_MIS RS_MIS_PAIRWISE
 #endif
+// MIS (shared/restir_mis.h) reads the inputs through these accessors.
+#define RS_MIS_M(j) in_.res[j].M
+#define RS_MIS_OWN_TARGET(s) in_.res[s].p_hat
+#define RS_MIS_TARGET(s, j) rs_target_in(s, j)
+#include "../shared/restir_mis.h"
+
 void rs_reuse(uint outSet, uint outPixel, inout RngState rng) {
-  const uint misKind = PLUME_RS_MIS;
   float Msum = 0.0f;
   for (uint s = 0u; s < in_.count; ++s) Msum += in_.res[s].M;
-  float Mc = in_.res[0].M;
   RsReservoir out_ = rs_empty();
   uint selected = RS_MAX_INPUTS;
   for (uint s = 0u; s < in_.count; ++s) {
     RsReservoir rs_ = in_.res[s];
-    bool hasSample = rs_.W > 0.0f && rsPaths[rs_slot(rs_input_set(s), in_.pixel[s])].info.x > 0u;
+    bool hasSample = rs_.W > 0.0f && rsPaths[rs_slot(rs_input_set(s), in_.pixel[s])].vertexCount > 0u;
     float phC = 0.0f;
     float m = 0.0f;
     if (hasSample) {
       phC = rs_target_in(s, 0u);
-      if (misKind == RS_MIS_BIASED) {
-        m = rs_.M / Msum;
-      } else if (misKind == RS_MIS_GBH) {
-        float denom = 0.0f;
-        for (uint j = 0u; j < in_.count; ++j) {
-          denom += in_.res[j].M * (j == 0u ? phC : rs_target_in(s, j));
-        }
-        m = rs_gbh(rs_.M, rs_.p_hat, denom);
-      } else if (s == 0u) {
-        m = Mc / Msum;
-        for (uint i = 1u; i < in_.count; ++i) {
-          m += rs_pairwise_canonical_term(in_.res[i].M, rs_target_in(0u, i), Mc, phC, Msum);
-        }
-      } else {
-        m = rs_pairwise_neighbour(rs_.M, rs_.p_hat, Mc, phC, Msum);
-      }
+      m = rs_mis_weight(PLUME_RS_MIS, s, in_.count, Msum, phC);
     }
     if (rs_merge(out_, rs_, phC, 1.0f, m, rng_float(rng))) selected = s;
   }
@@ -88,7 +77,7 @@ void rs_reuse(uint outSet, uint outPixel, inout RngState rng) {
     out_.w_sum = 0.0f;
     out_.p_hat = 0.0f;
     out_.W = 0.0f;
-    rsPaths[rs_slot(outSet, outPixel)].info.x = 0u;
+    rsPaths[rs_slot(outSet, outPixel)].vertexCount = 0u;
   }
   rs_store(outSet, outPixel, out_);
 }
@@ -98,15 +87,15 @@ void rs_reuse(uint outSet, uint outPixel, inout RngState rng) {
 // cameras only, never on a sample. False when it falls outside the previous image.
 bool rs_reproject(uvec2 pixel, out uvec2 prevPixel) {
   prevPixel = pixel;
-  vec3 dir = normalize(cam_direction(vec2(pixel) + 0.5f, frame.image.xy, frame.camPosition, frame.camForward,
-                                     frame.camRight, frame.camUp));
-  vec3 p = frame.camPosition.xyz + rsp.configF.z * dir - rsp.prevCamPosition.xyz;
-  float z = dot(p, rsp.prevCamForward.xyz);
+  vec3 dir = normalize(cam_direction(vec2(pixel) + 0.5f, frame.size, frame.camera));
+  GpuCamera prev = rsp.prevCamera;
+  vec3 p = frame.camera.position + rsp.reprojectionDepth * dir - prev.position;
+  float z = dot(p, prev.forward);
   if (!(z > 0.0f)) return false;
-  float px = dot(p, rsp.prevCamRight.xyz) / (z * rsp.prevCamPosition.w * rsp.prevCamForward.w);
-  float py = dot(p, rsp.prevCamUp.xyz) / (z * rsp.prevCamPosition.w);
-  vec2 f = vec2((px + 1.0f) * 0.5f * float(frame.image.x), (1.0f - py) * 0.5f * float(frame.image.y));
-  if (!(f.x >= 0.0f && f.y >= 0.0f && f.x < float(frame.image.x) && f.y < float(frame.image.y))) return false;
+  float px = dot(p, prev.right) / (z * prev.tanHalfFovY * prev.aspect);
+  float py = dot(p, prev.up) / (z * prev.tanHalfFovY);
+  vec2 f = vec2((px + 1.0f) * 0.5f * float(frame.size.x), (1.0f - py) * 0.5f * float(frame.size.y));
+  if (!(f.x >= 0.0f && f.y >= 0.0f && f.x < float(frame.size.x) && f.y < float(frame.size.y))) return false;
   prevPixel = uvec2(f);
   return true;
 }
@@ -124,26 +113,26 @@ void rs_reuse_pixel(uvec2 pixel, uint index, bool temporal, uint spatialRound, u
   in_.pixel[0] = index;
   in_.res[0] = rs_load(inSet, index);
   uint stream = temporal ? RNG_STREAM_TEMPORAL : RNG_STREAM_SPATIAL + (spatialRound << 8u);
-  RngState rng = rng_init(pixel, frame.seeds.y, stream, frame.seeds.x);
+  RngState rng = rng_init(pixel, frame.frameKey, stream, frame.seed);
   if (temporal) {
     uvec2 q;
-    if (rsp.frames.z != 0u && rs_reproject(pixel, q)) {
-      uint qi = q.y * frame.image.x + q.x;
+    if (rsp.historyValid != 0u && rs_reproject(pixel, q)) {
+      uint qi = q.y * frame.size.x + q.x;
       in_.history = true;
       in_.pixel[1] = qi;
-      in_.sameDomain = rsp.misc.y != 0u && qi == index;
+      in_.sameDomain = rsp.historySameDomain != 0u && qi == index;
       in_.res[1] = rs_load(histSet, qi);
-      rs_cap_confidence(in_.res[1], rsp.configF.y * in_.res[0].M);
+      rs_cap_confidence(in_.res[1], rsp.historyCap * in_.res[0].M);
       in_.count = 2u;
     }
   } else {
-    for (uint i = 0u; i < rsp.config.y; ++i) {
+    for (uint i = 0u; i < rsp.neighbours; ++i) {
       vec2 u = rng_float2(rng);  // neighbour offsets: uniform in the disk, independent of samples
-      float radius = rsp.configF.x * sqrt(u.x);
+      float radius = rsp.radius * sqrt(u.x);
       ivec2 q = ivec2(pixel) + ivec2(round(radius * vec2(cos(2.0f * PLUME_PI * u.y), sin(2.0f * PLUME_PI * u.y))));
-      if (any(lessThan(q, ivec2(0))) || q.x >= int(frame.image.x) || q.y >= int(frame.image.y)) continue;
+      if (any(lessThan(q, ivec2(0))) || q.x >= int(frame.size.x) || q.y >= int(frame.size.y)) continue;
       if (q == ivec2(pixel)) continue;
-      uint qi = uint(q.y) * frame.image.x + uint(q.x);
+      uint qi = uint(q.y) * frame.size.x + uint(q.x);
       uint k = in_.count++;
       in_.pixel[k] = qi;
       in_.res[k] = rs_load(inSet, qi);

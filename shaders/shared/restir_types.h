@@ -12,11 +12,12 @@
 // Its contribution f_D(y) in a domain D (pixel of a frame, volume) is measured in du dv dt1 dw2 dt2 ... dw_L,
 // so copying the coordinates into another domain has Jacobian 1 and the light reconnection to a
 // direction or a point has none either. A future surface vertex is one more kind of vertex in
-// the same list (a flag in RsPathHead.info.z), with its own measure and Jacobian.
+// the same list (a bit in RsPathHead.kinds), with its own measure and Jacobian.
 #ifndef PLUME_SHARED_RESTIR_TYPES_H
 #define PLUME_SHARED_RESTIR_TYPES_H
 
 #include "common.h"
+#include "gpu_types.h"
 
 PLUME_NS_BEGIN
 
@@ -29,30 +30,48 @@ const uint RS_MIS_BIASED = 2u;    // restir-biased: m_i = M_i / sum M, no MIS (b
 
 
 // Stored path header (one per pixel and reservoir set); vertices 2..n live in a separate buffer
-// of vec4(direction, t), RestirParams.config.w (= max_bounces - 1) slots per pixel and set.
+// of vec4(direction, t), RestirParams.bounceStride (= max_bounces - 1) slots per pixel and set.
 struct RsPathHead {
-  vec4 geo;   // x: t1; y, z: light sample; w: unused
-  uvec4 info; // x: vertex count n (0: no path); y: light index; z: vertex kinds (0: all media);
-              // w: sub-pixel position (u, v) as two 16-bit unorms (restir/bridge.glsl)
+  vec2 lightSample;  // the light sample's two floats (rs_encode_dir of a direction, or unused)
+  float t1;          // distance of the first vertex along the camera ray
+  uint vertexCount;  // n (0: no path)
+  uint light;        // index of the light that ends the path
+  uint kinds;        // vertex kinds, one bit per vertex (integrator/vertex.glsl; 0: all media)
+  uint uv;           // sub-pixel position (u, v) as two 16-bit unorms (restir/bridge.glsl)
+  uint pad0;
 };
 
-// Per-frame parameters of the ReSTIR passes (beside GpuFrame, which holds the current camera).
+// Per-frame parameters of the ReSTIR passes (beside GpuFrame, which holds the current camera),
+// grouped by stage.
 struct RestirParams {
-  vec4 prevCamPosition;  // previous frame's camera (same layout as GpuFrame's)
-  vec4 prevCamForward;
-  vec4 prevCamRight;
-  vec4 prevCamUp;
-  uvec4 config;   // x: M candidates; y: k neighbours; z: unused (PLUME_RS_MIS); w: bounce stride
-  vec4 configF;   // x: spatial radius (px); y: history cap c; z: reprojection depth (world); w: unused
-  uvec4 frames;   // x: unused; y: pixel count; z: history valid (0/1); w: light count
-  uvec4 misc;     // x: unused;
-                  // y: 1 = the history's domain is the current one (still camera and volume)
+  GpuCamera prevCamera;     // temporal: the previous frame's camera
+  // Candidates (DESIGN §4.2 step 1)
+  uint candidates;          // M
+  uint bounceStride;        // path vertex slots per pixel and set (max_bounces - 1, at least 1)
+  uint pixelCount;
+  uint lightCount;
+  // Temporal reuse (step 5)
+  uint historyValid;        // 1: the history set holds the previous frame's reservoirs
+  uint historySameDomain;   // 1: the history's domain is the current one (still camera and volume)
+  float historyCap;         // c: history confidence <= c * M
+  float reprojectionDepth;  // world distance along the pixel's ray that is reprojected
+  // Spatial reuse (step 6)
+  uint neighbours;          // k
+  float radius;             // px
+  uint pad0;
+  uint pad1;
 };
 
 // Push constants: which reservoir sets a pass reads and writes.
 struct RsPush {
-  uvec4 sets;  // x: canonical input set; y: history set; z: output set; w: unused (PLUME_RS_TEMPORAL)
-  uvec4 misc;  // x: spatial round; y: shading restarts the accumulation (1) or adds to it (0)
+  uint inSet;                // canonical input set
+  uint historySet;           // temporal reuse's history set
+  uint outSet;               // output set
+  uint spatialRound;         // spatial reuse's round (its random stream)
+  uint restartAccumulation;  // final shading: 1 restarts the accumulation, 0 adds to it
+  uint pad0;
+  uint pad1;
+  uint pad2;
 };
 
 // --- Light sample encoding: a unit direction as (z, phi), exact enough for float storage ---
@@ -101,9 +120,9 @@ PLUME_NS_END
 #ifdef __cplusplus
 #include <cstddef>
 static_assert(sizeof(plume::shared::RsPathHead) == 32, "RsPathHead crosses the bus");
-static_assert(offsetof(plume::shared::RsPathHead, info) == 16, "RsPathHead layout");
-static_assert(sizeof(plume::shared::RestirParams) == 8 * 16, "RestirParams layout");
-static_assert(offsetof(plume::shared::RestirParams, config) == 64, "RestirParams layout");
+static_assert(offsetof(plume::shared::RsPathHead, vertexCount) == 12, "RsPathHead layout");
+static_assert(offsetof(plume::shared::RestirParams, candidates) == 64, "RestirParams layout");
+static_assert(sizeof(plume::shared::RestirParams) == 64 + 3 * 16, "RestirParams layout");
 static_assert(sizeof(plume::shared::RsPush) == 32, "RsPush layout");
 #endif
 

@@ -7,7 +7,8 @@ layout(local_size_x = 64) in;
 
 #include "../shared/gpu_types.h"
 #include "../volume/bindings.glsl"
-#include "../volume/volume.glsl"
+#include "../shared/rng.h"
+#include "../volume/grid.glsl"
 #include "../shared/phase.h"
 #include "../shared/sampling.h"
 
@@ -24,8 +25,11 @@ struct KernelResult {
   vec4 coneDir; // smp_uniform_cone(wi, 0.1, u2)
 };
 
-layout(std430, binding = 5) readonly buffer Cases { KernelCase cases[]; };
-layout(std430, binding = 6) writeonly buffer Results { KernelResult results[]; };
+// Bindings after the volume's (shared/bindings.h): this test pass's own.
+const uint BIND_TEST_CASES = BIND_VOLUME_COUNTERS + 1u;
+const uint BIND_TEST_RESULTS = BIND_VOLUME_COUNTERS + 2u;
+layout(std430, binding = BIND_TEST_CASES) readonly buffer Cases { KernelCase cases[]; };
+layout(std430, binding = BIND_TEST_RESULTS) writeonly buffer Results { KernelResult results[]; };
 layout(push_constant) uniform Push { uint count; } pc;
 
 void main() {
@@ -38,7 +42,7 @@ void main() {
   o.rng1 = uvec4(rng_uint(r), rng_uint(r), rng_uint(r), rng_uint(r));
   float g = c.point.w;
   vec2 u = rng_float2(r);
-  o.phase = vec4(ph_hg(c.dir.w, g), ph_hg_sample_cos(g, u.x), vol_density(c.point.xyz), 0.0f);
+  o.phase = vec4(ph_hg(c.dir.w, g), ph_hg_sample_cos(g, u.x), vol_density(VOL_CURRENT, c.point.xyz), 0.0f);
   o.hgDir = vec4(ph_hg_sample(c.dir.xyz, g, u), 0.0f);
   o.coneDir = vec4(smp_uniform_cone(c.dir.xyz, 0.1f, u), 0.0f);
   results[i] = o;

@@ -159,6 +159,15 @@ std::vector<std::pair<std::string, double>> GpuTimer::read() {
   return out;
 }
 
+std::vector<BindingType> bindingTable(uint32_t count, std::initializer_list<std::pair<uint32_t, BindingType>> others) {
+  std::vector<BindingType> table(count, BindingType::StorageBuffer);
+  for (const auto& [binding, type] : others) {
+    PLUME_CHECK(binding < count);
+    table[binding] = type;
+  }
+  return table;
+}
+
 void computeBarrier(VkCommandBuffer cmd) {
   VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
   b.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;

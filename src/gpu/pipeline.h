@@ -9,6 +9,7 @@
 #include <glm/vec3.hpp>
 #include <vulkan/vulkan.h>
 
+#include <initializer_list>
 #include <string>
 #include <utility>
 #include <vector>
@@ -16,6 +17,10 @@
 namespace plume::gpu {
 
 enum class BindingType { StorageBuffer, UniformBuffer, SampledImage };
+
+// A pass's binding table: bindings 0 .. count-1 are storage buffers except those listed with
+// another type (binding numbers are named in shaders/shared/bindings.h).
+std::vector<BindingType> bindingTable(uint32_t count, std::initializer_list<std::pair<uint32_t, BindingType>> others);
 
 class ComputePipeline {
  public:

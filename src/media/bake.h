@@ -76,7 +76,7 @@ struct BakedVolume {
   // and of the stored texels) times (1 + 2^-18), which bounds the float rounding of a lookup.
   std::vector<MaxLevel> maxLevels;
 
-  // ReSTIR's mean field on the GPU (restir/coarse.glsl), per slot (slot 0 zeros), on single
+  // ReSTIR's mean field on the GPU (volume/walk.glsl), per slot (slot 0 zeros), on single
   // voxels, stored as two float16 per voxel (packedMeanField); these are the values the GPU
   // reads: voxelMean[slot*512 + (z*8+y)*8+x] is the mean of the trilinear field over voxel
   // [v, v+1]³ (the mean of its 8 corner texels, also the field's value at the voxel's centre),

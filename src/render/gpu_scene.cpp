@@ -25,27 +25,27 @@ std::vector<shared::GpuLight> gpuLights(const Scene& scene) {
     shared::GpuLight g{};
     switch (l.type) {
       case LightType::Sun: {
-        g.dirOrPos = glm::vec4(glm::normalize(l.toLight), 0.0f);
+        g.type = shared::LIGHT_SUN;
+        g.dirOrPos = glm::normalize(l.toLight);
         const double alpha = glm::radians(double(l.angularRadiusDeg));
         if (alpha > 0) {
           // A disk of uniform radiance L with irradiance E: E = L * pi * sin^2(alpha).
-          g.emission = glm::vec4(glm::dvec3(l.irradiance) / (M_PI * std::sin(alpha) * std::sin(alpha)), 0.0f);
-          const double versine = 2.0 * std::sin(0.5 * alpha) * std::sin(0.5 * alpha);  // 1 - cos(alpha)
-          g.params = glm::vec4(float(shared::LIGHT_SUN), float(versine), 0.0f, 0.0f);
+          g.emission = glm::vec3(glm::dvec3(l.irradiance) / (M_PI * std::sin(alpha) * std::sin(alpha)));
+          g.versine = float(2.0 * std::sin(0.5 * alpha) * std::sin(0.5 * alpha));  // 1 - cos(alpha)
         } else {
-          g.emission = glm::vec4(l.irradiance, 0.0f);
-          g.params = glm::vec4(float(shared::LIGHT_SUN), 0.0f, 0.0f, 0.0f);
+          g.emission = l.irradiance;
+          g.versine = 0.0f;
         }
         break;
       }
       case LightType::Point:
-        g.dirOrPos = glm::vec4(l.position, 1.0f);
-        g.emission = glm::vec4(l.intensity, 0.0f);
-        g.params = glm::vec4(float(shared::LIGHT_POINT), 0.0f, 0.0f, 0.0f);
+        g.type = shared::LIGHT_POINT;
+        g.dirOrPos = l.position;
+        g.emission = l.intensity;
         break;
       case LightType::Environment:
-        g.emission = glm::vec4(l.radiance * l.scale, 0.0f);
-        g.params = glm::vec4(float(shared::LIGHT_ENVIRONMENT), 0.0f, 0.0f, 0.0f);
+        g.type = shared::LIGHT_ENVIRONMENT;
+        g.emission = l.radiance * l.scale;
         break;
     }
     out.push_back(g);
@@ -57,32 +57,39 @@ std::vector<shared::GpuLight> gpuLights(const Scene& scene) {
   return out;
 }
 
-void gpuCameraVectors(const Camera& cam, int frame, glm::vec4 out[4]) {
+shared::GpuCamera gpuCamera(const Camera& cam, int frame) {
   const CameraPose pose = cam.poseAt(frame);
-  const glm::vec3 forward = glm::normalize(pose.lookAt - pose.position);
-  const glm::vec3 right = glm::normalize(glm::cross(forward, pose.up));
-  const glm::vec3 up = glm::cross(right, forward);
-  out[0] = glm::vec4(pose.position, float(std::tan(glm::radians(double(pose.fovY)) * 0.5)));
-  out[1] = glm::vec4(forward, float(cam.width) / float(cam.height));
-  out[2] = glm::vec4(right, 0.0f);
-  out[3] = glm::vec4(up, 0.0f);
+  shared::GpuCamera c{};
+  c.position = pose.position;
+  c.tanHalfFovY = float(std::tan(glm::radians(double(pose.fovY)) * 0.5));
+  c.forward = glm::normalize(pose.lookAt - pose.position);
+  c.aspect = float(cam.width) / float(cam.height);
+  c.right = glm::normalize(glm::cross(c.forward, pose.up));
+  c.up = glm::cross(c.right, c.forward);
+  return c;
+}
+
+bool sameCamera(const shared::GpuCamera& a, const shared::GpuCamera& b) {
+  return a.position == b.position && a.tanHalfFovY == b.tanHalfFovY && a.forward == b.forward &&
+         a.aspect == b.aspect && a.right == b.right && a.up == b.up;
 }
 
 shared::GpuFrame gpuFrame(const Scene& scene, int frame, uint32_t seed, uint32_t frameKey, uint32_t sppPerDispatch) {
   const Camera& cam = scene.camera;
   const Medium& m = scene.media.at(0);
   const RenderSettings& rs = scene.render;
-  glm::vec4 c[4];
-  gpuCameraVectors(cam, frame, c);
   shared::GpuFrame f{};
-  f.camPosition = c[0];
-  f.camForward = c[1];
-  f.camRight = c[2];
-  f.camUp = c[3];
-  f.albedo = glm::vec4(m.albedo, m.g);
-  f.image = glm::uvec4(uint32_t(cam.width), uint32_t(cam.height), sppPerDispatch, uint32_t(rs.maxBounces));
-  f.seeds = glm::uvec4(seed, frameKey, 0u, uint32_t(rs.rrStartBounce));
-  f.lights = glm::uvec4(uint32_t(scene.lights.size()), 0u, 0u, 0u);
+  f.camera = gpuCamera(cam, frame);
+  f.albedo = m.albedo;
+  f.g = m.g;
+  f.size = glm::uvec2(uint32_t(cam.width), uint32_t(cam.height));
+  f.spp = sppPerDispatch;
+  f.maxBounces = uint32_t(rs.maxBounces);
+  f.seed = seed;
+  f.frameKey = frameKey;
+  f.firstSample = 0u;
+  f.rrStartBounce = uint32_t(rs.rrStartBounce);
+  f.lightCount = uint32_t(scene.lights.size());
   return f;
 }
 

@@ -21,9 +21,9 @@ void checkGpuSupports(const Scene& scene, const std::string& renderer);
 // Throws InputError for more than GPU_MAX_LIGHTS lights.
 std::vector<shared::GpuLight> gpuLights(const Scene& scene);
 
-// Camera of `frame` as GpuFrame's four vectors: position (w: tan(fovY/2)), forward (w: aspect),
-// right, up (DESIGN §2: right = normalize(cross(forward, up)), row 0 at the top).
-void gpuCameraVectors(const Camera& cam, int frame, glm::vec4 out[4]);
+// Camera of `frame` (DESIGN §2: right = normalize(cross(forward, up)), row 0 at the top).
+shared::GpuCamera gpuCamera(const Camera& cam, int frame);
+bool sameCamera(const shared::GpuCamera& a, const shared::GpuCamera& b);  // every field but the padding
 
 // GpuFrame of `frame`: camera, medium, image size, bounces and light count from the scene;
 // the random-stream seed and frame key, and the samples per dispatch, from the caller.

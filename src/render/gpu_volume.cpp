@@ -21,23 +21,27 @@ GpuVolumeResources::GpuVolumeResources(gpu::Context& ctx, const BakedVolume& bak
   const bool empty = bake.empty();
   params_.worldToIndex = bake.worldToIndex;
   params_.indexToWorld = bake.indexToWorld;
-  params_.brickOrigin = glm::ivec4(bake.brickOrigin, 0);
-  params_.brickDims = glm::ivec4(bake.brickDims, empty ? 1 : 0);
-  params_.atlasSlots = glm::ivec4(bake.atlasSlots, int(bake.format));
-  params_.boundsMin = glm::vec4(bake.indexBoundsMin, densityScale);
-  params_.boundsMax = glm::vec4(bake.indexBoundsMax, 0.0f);
+  params_.brickOrigin = bake.brickOrigin;
+  params_.empty = empty ? 1 : 0;
+  params_.brickDims = bake.brickDims;
+  params_.texelFormat = int(bake.format);
+  params_.atlasSlots = bake.atlasSlots;
+  params_.boundsMin = bake.indexBoundsMin;
+  params_.densityScale = densityScale;
+  params_.boundsMax = bake.indexBoundsMax;
   const size_t levels = std::min<size_t>(bake.maxLevels.size(), GPU_MAX_LEVELS);
   std::vector<float> majorants;
   for (size_t k = 0; k < levels; ++k) {
     const MaxLevel& L = bake.maxLevels[k];
-    params_.levelDims[k] = glm::ivec4(L.dims, L.cellBricks);
+    params_.levels[k].cells = L.dims;
+    params_.levels[k].bricksPerCell = L.cellBricks;
     params_.levelOffset[int(k)] = uint32_t(majorants.size());
     majorants.insert(majorants.end(), L.max.begin(), L.max.end());
   }
   if (!empty && (levels == 0 || bake.maxLevels[0].dims != bake.brickDims)) {
     throw InternalError("bake: level 0 of the majorant hierarchy must match the indirection grid");
   }
-  params_.info = glm::uvec4(uint32_t(levels), 0, 0, 0);
+  params_.levelCount = uint32_t(levels);
 
   const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   paramBuffer_ = gpu::Buffer(ctx, sizeof(params_), storage, "volume parameters");
@@ -66,7 +70,7 @@ GpuVolumeResources::GpuVolumeResources(gpu::Context& ctx, const BakedVolume& bak
   majorants_ = gpu::Buffer(ctx, majorants.size() * 4, storage, "majorant hierarchy");
   majorants_.upload(majorants.data(), majorants.size() * 4);
   // Per atlas slot 512 words: each voxel's mean and residual bound as two float16
-  // (bake.h packedMeanField; restir/coarse.glsl).
+  // (bake.h packedMeanField; volume/walk.glsl).
   std::vector<uint32_t> coarse = packedMeanField(bake);
   // Baked without it (a path-traced render): a placeholder, so that binding sets stay valid.
   hasMeanField_ = !coarse.empty();
@@ -79,28 +83,27 @@ GpuVolumeResources::GpuVolumeResources(gpu::Context& ctx, const BakedVolume& bak
 }
 
 void GpuVolumeResources::setDensityScale(float densityScale) {
-  if (params_.boundsMin.w == densityScale) return;
-  params_.boundsMin.w = densityScale;
+  if (params_.densityScale == densityScale) return;
+  params_.densityScale = densityScale;
   paramBuffer_.upload(&params_, sizeof(params_));
   serial_ = newSerial();  // another medium: renderers must not take it for the one they rendered
 }
 
 void GpuVolumeResources::bind(gpu::DescriptorSet& set) const {
-  set.bind(0, paramBuffer_);
-  set.bind(1, atlas_);
-  set.bind(2, indirection_);
-  set.bind(3, majorants_);
-  set.bind(4, counters_);
+  set.bind(shared::BIND_VOLUME, paramBuffer_);
+  set.bind(shared::BIND_ATLAS, atlas_);
+  set.bind(shared::BIND_INDIRECTION, indirection_);
+  set.bind(shared::BIND_MAJORANTS, majorants_);
+  set.bind(shared::BIND_VOLUME_COUNTERS, counters_);
 }
 
-void GpuVolumeResources::bindCoarse(gpu::DescriptorSet& set, uint32_t coarse) const { set.bind(coarse, coarse_); }
+void GpuVolumeResources::bindMeanField(gpu::DescriptorSet& set) const { set.bind(shared::BIND_MEAN_FIELD, coarse_); }
 
-void GpuVolumeResources::bindAsPrevious(gpu::DescriptorSet& set, uint32_t params, uint32_t atlas,
-                                        uint32_t indirection, uint32_t coarse) const {
-  set.bind(params, paramBuffer_);
-  set.bind(atlas, atlas_);
-  set.bind(indirection, indirection_);
-  set.bind(coarse, coarse_);
+void GpuVolumeResources::bindAsPrevious(gpu::DescriptorSet& set) const {
+  set.bind(shared::BIND_PREV_VOLUME, paramBuffer_);
+  set.bind(shared::BIND_PREV_ATLAS, atlas_);
+  set.bind(shared::BIND_PREV_INDIRECTION, indirection_);
+  set.bind(shared::BIND_PREV_MEAN_FIELD, coarse_);
 }
 
 uint32_t GpuVolumeResources::truncatedCount() const {

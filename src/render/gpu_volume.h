@@ -1,12 +1,13 @@
 // The baked volume on the device (DESIGN §3): the brick atlas as a 3D texture (R16F or R32F),
 // the indirection and the majorant hierarchy as storage buffers, ReSTIR's voxel mean field, and
-// the GpuVolume parameter block. Bindings 0..4 of every volume pass
+// the GpuVolume parameter block. Bound by the names of shaders/shared/bindings.h
 // (shaders/volume/bindings.glsl).
 #pragma once
 
 #include "gpu/pipeline.h"
 #include "gpu/resources.h"
 #include "media/bake.h"
+#include "shaders/shared/bindings.h"
 #include "shaders/shared/gpu_types.h"
 
 namespace plume {
@@ -15,15 +16,14 @@ class GpuVolumeResources {
  public:
   GpuVolumeResources(gpu::Context& ctx, const BakedVolume& bake, float densityScale);
 
-  // Binds params (0), atlas (1), indirection (2), majorants (3), counters (4).
+  // Binds params, atlas, indirection, majorants and counters (BIND_VOLUME .. BIND_VOLUME_COUNTERS).
   void bind(gpu::DescriptorSet& set) const;
-  // Binds ReSTIR's mean field at `coarse` (binding 8): 512 words per atlas slot (slot index
+  // Binds ReSTIR's mean field (BIND_MEAN_FIELD): 512 words per atlas slot (slot index
   // x + X * (y + Y * z) of the packed slot coordinates), each voxel's mean and residual bound as
   // two float16 (bake.h packedMeanField).
-  void bindCoarse(gpu::DescriptorSet& set, uint32_t coarse) const;
-  // Binds this volume as ReSTIR's previous-frame volume (bindings 9..12 of restir/bindings.glsl).
-  void bindAsPrevious(gpu::DescriptorSet& set, uint32_t params, uint32_t atlas, uint32_t indirection,
-                      uint32_t coarse) const;
+  void bindMeanField(gpu::DescriptorSet& set) const;
+  // Binds this volume as ReSTIR's previous-frame volume (BIND_PREV_*).
+  void bindAsPrevious(gpu::DescriptorSet& set) const;
   const shared::GpuVolume& params() const { return params_; }
   // Changes the density scale in place (one small upload; the atlas and fields stay). The volume
   // then counts as a new one (serial). Not while a submitted pass still reads it.

@@ -66,13 +66,11 @@ gpu::ComputePass& PathTracer::makePass(bool skipEmpty) {
   if (skipEmpty) defines.emplace_back("PLUME_SKIP_EMPTY", "1");
   pass = std::make_unique<gpu::ComputePass>(
       ctx_, compiler_.compile("passes/pt.comp", defines),
-      std::vector<BindingType>{BindingType::StorageBuffer, BindingType::SampledImage, BindingType::StorageBuffer,
-                               BindingType::StorageBuffer, BindingType::StorageBuffer, BindingType::StorageBuffer,
-                               BindingType::StorageBuffer, BindingType::StorageBuffer},
-      0, "path tracing [" + features_.name() + (skipEmpty ? "+skip" : "") + "]", glm::uvec3(8, 8, 1));
-  pass->set.bind(5, frameBuffer_);
-  pass->set.bind(6, lightBuffer_);
-  pass->set.bind(7, accum_);
+      gpu::bindingTable(shared::BIND_PT_ACCUM + 1, {{shared::BIND_ATLAS, BindingType::SampledImage}}), 0,
+      "path tracing [" + features_.name() + (skipEmpty ? "+skip" : "") + "]", glm::uvec3(8, 8, 1));
+  pass->set.bind(shared::BIND_FRAME, frameBuffer_);
+  pass->set.bind(shared::BIND_LIGHTS, lightBuffer_);
+  pass->set.bind(shared::BIND_PT_ACCUM, accum_);
   return *pass;
 }
 
@@ -82,7 +80,7 @@ void PathTracer::setVolume(const GpuVolumeResources& volume) {
   // Skipping pays when rays cross many bricks: a brick grid wider than 16 on some axis.
   const shared::GpuVolume& p = volume.params();
   const int widest = std::max(p.brickDims.x, std::max(p.brickDims.y, p.brickDims.z));
-  skipEmpty_ = p.info.x >= 2u && widest > 16;
+  skipEmpty_ = p.levelCount >= 2u && widest > 16;
   pass_ = &makePass(skipEmpty_);
   volume.bind(pass_->set);
 }
@@ -94,8 +92,8 @@ void PathTracer::beginFrame(int frame) {
 }
 
 void PathTracer::addSamples(int spp) {
-  frame_.image.z = uint32_t(spp);
-  frame_.seeds.z = uint32_t(samples_);
+  frame_.spp = uint32_t(spp);
+  frame_.firstSample = uint32_t(samples_);
   frameBuffer_.upload(&frame_, sizeof(frame_));
   const glm::uvec3 items(uint32_t(scene_.camera.width), uint32_t(scene_.camera.height), 1u);
   ctx_.submitAndWait([&](VkCommandBuffer cmd) {

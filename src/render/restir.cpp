@@ -30,8 +30,8 @@ RestirOptions restirOptionsOf(const RenderSettings& rs) {
 
 namespace {
 
-// The GPU lights with each light's probability of being chosen for a candidate's light sample
-// (params.z) and the running sum (params.w): 90% in proportion to an estimate of the light's
+// Each light's probability of being chosen for a candidate's light sample and the running sum
+// (shared::GpuLightChoice): 90% in proportion to an estimate of the light's
 // contribution to a scattering point at the volume's centre (phase-averaged: a sun's irradiance
 // or a point light's intensity / r^2 over 4 pi, an environment's radiance), 10% uniform, so no
 // light with a nonzero estimate is starved. A uniform choice spent half the candidates of the
@@ -39,10 +39,10 @@ namespace {
 // (bundled smoke at 128², r2: 4.85x -> 5.26x static, 3.79x -> 3.70x moving with one light by
 // power; Blender smoke: 3.53x -> 5.19x and 2.72x -> 3.48x: the sky's light rays through dense
 // smoke carry almost nothing).
-std::vector<shared::GpuLight> restirLights(const Scene& scene, glm::vec3 centre) {
-  std::vector<shared::GpuLight> lights = gpuLights(scene);
+std::vector<shared::GpuLightChoice> lightChoice(const Scene& scene, glm::vec3 centre) {
   const size_t n = scene.lights.size();
-  if (n == 0) return lights;
+  std::vector<shared::GpuLightChoice> choice(std::max<size_t>(n, 1), shared::GpuLightChoice{});
+  if (n == 0) return choice;
   auto lum = [](glm::vec3 c) { return std::max(0.0, (double(c.x) + c.y + c.z) / 3.0); };
   std::vector<double> power(n, 0.0);
   double total = 0.0;
@@ -63,10 +63,10 @@ std::vector<shared::GpuLight> restirLights(const Scene& scene, glm::vec3 centre)
   for (size_t i = 0; i < n; ++i) {
     const double p = total > 0.0 ? 0.9 * power[i] / total + 0.1 / double(n) : 1.0 / double(n);
     cdf += p;
-    lights[i].params.z = float(p);
-    lights[i].params.w = i + 1 == n ? 2.0f : float(cdf);  // the last light catches rounding
+    choice[i].probability = float(p);
+    choice[i].cdf = i + 1 == n ? 2.0f : float(cdf);  // the last light catches rounding
   }
-  return lights;
+  return choice;
 }
 
 constexpr uint32_t kSets = 3;  // candidates / temporal / spatial rotate through three sets
@@ -85,10 +85,9 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
     throw InputError(scene.path + strf(": render.restir_neighbours: at most %u", shared::RS_MAX_NEIGHBOURS));
   }
   using gpu::BindingType;
-  const BindingType SB = BindingType::StorageBuffer, IMG = BindingType::SampledImage;
-  // restir/bindings.glsl: 0..4 volume, 5 frame, 6 lights, 7 params, 8 coarse, 9..12 previous
-  // volume, 13 reservoirs, 14 paths, 15 bounces, 16 output, 17 counters.
-  const std::vector<BindingType> bindings = {SB, IMG, SB, SB, SB, SB, SB, SB, SB, SB, IMG, SB, SB, SB, SB, SB, SB, SB};
+  // shaders/restir/bindings.glsl (numbers in shaders/shared/bindings.h)
+  const std::vector<BindingType> bindings = gpu::bindingTable(
+      shared::RS_BINDING_COUNT, {{shared::BIND_ATLAS, BindingType::SampledImage}, {shared::BIND_PREV_ATLAS, BindingType::SampledImage}});
   const gpu::ShaderDefines defines = features_.defines();
   const std::string variant = " [" + features_.name() + "]";
   // Each pass is compiled with only the code its options use (MIS kind, temporal or spatial,
@@ -97,7 +96,7 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   auto make = [&](const char* file, const char* name, gpu::ShaderDefines extra) {
     gpu::ShaderDefines d = defines;
     // Final shading estimates f / p̂ per segment by residual ratio tracking against the target's
-    // mean field (restir/coarse.glsl) at 16x the residual majorant: on the bundled smoke (64²,
+    // mean field (volume/walk.glsl) at 16x the residual majorant: on the bundled smoke (64²,
     // temporal reuse) relMSE 0.011 at 1x, 0.0082 at 2x, 0.0054 at 8x, 0.0046 at 16x, 0.0046 at
     // 32x, shading 3.4 -> 5.9 ms; 16x is where the error stops falling (notes/restir.md).
     d.emplace_back("PLUME_RS_RESIDUAL_SCALE", "16.0f");
@@ -115,8 +114,10 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   const size_t pixels = size_t(scene.camera.width) * scene.camera.height;
   const uint32_t stride = uint32_t(std::max(1, scene.render.maxBounces - 1));
   frameBuffer_ = gpu::Buffer(ctx, sizeof(shared::GpuFrame), storage, "frame parameters");
-  const size_t lightCount = gpuLights(scene).size();
-  lightBuffer_ = gpu::Buffer(ctx, lightCount * sizeof(shared::GpuLight), storage, "lights");
+  const std::vector<shared::GpuLight> lights = gpuLights(scene);
+  lightBuffer_ = gpu::Buffer(ctx, lights.size() * sizeof(shared::GpuLight), storage, "lights");
+  lightBuffer_.upload(lights.data(), lights.size() * sizeof(shared::GpuLight));
+  lightChoice_ = gpu::Buffer(ctx, lights.size() * sizeof(shared::GpuLightChoice), storage, "light choice");
   paramBuffer_ = gpu::Buffer(ctx, sizeof(shared::RestirParams), storage, "restir parameters");
   reservoirs_ = gpu::Buffer(ctx, kSets * pixels * sizeof(shared::RsPacked), storage, "reservoirs");
   paths_ = gpu::Buffer(ctx, kSets * pixels * sizeof(shared::RsPathHead), storage, "reservoir paths");
@@ -127,62 +128,62 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   reservoirs_.fillZero();
   paths_.fillZero();
   for (gpu::ComputePass* p : {candidates_.get(), temporal_.get(), spatial_.get(), shade_.get()}) {
-    p->set.bind(5, frameBuffer_);
-    p->set.bind(6, lightBuffer_);
-    p->set.bind(7, paramBuffer_);
-    p->set.bind(13, reservoirs_);
-    p->set.bind(14, paths_);
-    p->set.bind(15, bounces_);
-    p->set.bind(16, output_);
-    p->set.bind(17, counters_);
+    p->set.bind(shared::BIND_FRAME, frameBuffer_);
+    p->set.bind(shared::BIND_LIGHTS, lightBuffer_);
+    p->set.bind(shared::BIND_LIGHT_CHOICE, lightChoice_);
+    p->set.bind(shared::BIND_RS_PARAMS, paramBuffer_);
+    p->set.bind(shared::BIND_RS_RESERVOIRS, reservoirs_);
+    p->set.bind(shared::BIND_RS_PATHS, paths_);
+    p->set.bind(shared::BIND_RS_BOUNCES, bounces_);
+    p->set.bind(shared::BIND_RS_OUTPUT, output_);
+    p->set.bind(shared::BIND_RS_COUNTERS, counters_);
   }
-  params_.config = glm::uvec4(uint32_t(options_.candidates), uint32_t(options_.neighbours), 0u, stride);
-  params_.configF = glm::vec4(float(options_.radius), float(options_.historyCap), 1.0f, 0.0f);
-  params_.frames = glm::uvec4(0u, uint32_t(pixels), 0u, uint32_t(scene.lights.size()));
-  params_.misc = glm::uvec4(0u);
+  params_.candidates = uint32_t(options_.candidates);
+  params_.bounceStride = stride;
+  params_.pixelCount = uint32_t(pixels);
+  params_.lightCount = uint32_t(scene.lights.size());
+  params_.historyCap = float(options_.historyCap);
+  params_.reprojectionDepth = 1.0f;
+  params_.neighbours = uint32_t(options_.neighbours);
+  params_.radius = float(options_.radius);
 }
 
 void Restir::setVolumes(const GpuVolumeResources& current, const GpuVolumeResources& previous) {
   PLUME_CHECK(current.hasMeanField() && previous.hasMeanField());  // baked with BakeOptions::meanField
   for (gpu::ComputePass* p : {candidates_.get(), temporal_.get(), spatial_.get(), shade_.get()}) {
     current.bind(p->set);
-    current.bindCoarse(p->set, 8);
-    previous.bindAsPrevious(p->set, 9, 10, 11, 12);
+    current.bindMeanField(p->set);
+    previous.bindAsPrevious(p->set);
   }
   // Reprojection depth: the distance from the camera to the volume's centre (a per-frame
   // constant, so the history pixel never depends on a sample).
   const shared::GpuVolume& v = current.params();
-  const glm::vec3 centre = glm::vec3(v.indexToWorld * glm::vec4(0.5f * (glm::vec3(v.boundsMin) + glm::vec3(v.boundsMax)), 1.0f));
+  const glm::vec3 centre = glm::vec3(v.indexToWorld * glm::vec4(0.5f * (v.boundsMin + v.boundsMax), 1.0f));
   centre_ = centre;
   currentSerial_ = current.serial();
   previousSerial_ = previous.serial();
-  std::vector<shared::GpuLight> lights = restirLights(scene_, centre);
-  lightBuffer_.upload(lights.data(), lights.size() * sizeof(shared::GpuLight));
+  const std::vector<shared::GpuLightChoice> choice = lightChoice(scene_, centre);
+  lightChoice_.upload(choice.data(), choice.size() * sizeof(shared::GpuLightChoice));
 }
 
 void Restir::resetHistory() { hasHistory_ = false; }
 
 void Restir::fillFrame(int frame, uint32_t sequence, uint32_t key) {
   frame_ = gpuFrame(scene_, frame, uint32_t(scene_.render.seed) + 0x9E3779B9u * sequence, key, 1u);
-  const glm::vec4 c[4] = {frame_.camPosition, frame_.camForward, frame_.camRight, frame_.camUp};
+  const shared::GpuCamera& cam = frame_.camera;
   const bool history = hasHistory_ && options_.historyCap > 0 && prevSequence_ == sequence;
-  if (history) {
-    params_.prevCamPosition = prevCam_[0];
-    params_.prevCamForward = prevCam_[1];
-    params_.prevCamRight = prevCam_[2];
-    params_.prevCamUp = prevCam_[3];
-  }
-  params_.frames.z = history ? 1u : 0u;
+  if (history) params_.prevCamera = prevCam_;
+  params_.historyValid = history ? 1u : 0u;
   // The history's domain is the current one (a still camera over the grid it was rendered with):
   // the temporal shift is the identity and both cross-domain targets are the stored ones.
-  bool sameCamera = true;
-  for (int i = 0; i < 4; ++i) sameCamera = sameCamera && prevCam_[i] == c[i];
-  params_.misc.y = history && sameCamera && previousSerial_ == currentSerial_ && renderedSerial_ == currentSerial_ ? 1u : 0u;
+  const bool still = sameCamera(prevCam_, cam);
+  params_.historySameDomain =
+      history && still && previousSerial_ == currentSerial_ && renderedSerial_ == currentSerial_ ? 1u : 0u;
   renderedSerial_ = currentSerial_;
-  params_.configF.z = glm::length(centre_ - glm::vec3(c[0]));
+  params_.reprojectionDepth = glm::length(centre_ - cam.position);
   frameBuffer_.upload(&frame_, sizeof(frame_));
   paramBuffer_.upload(&params_, sizeof(params_));
-  for (int i = 0; i < 4; ++i) prevCam_[i] = c[i];
+  prevCam_ = cam;
 }
 
 Image Restir::renderFrame(int frame, uint32_t sequence, uint32_t iteration) {
@@ -196,7 +197,7 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
   PLUME_CHECK(iteration < kMaxIterations);
   const uint32_t key = uint32_t(frame) * kMaxIterations + iteration;
   fillFrame(frame, sequence, key);
-  const bool temporal = params_.frames.z != 0u;
+  const bool temporal = params_.historyValid != 0u;
   const glm::uvec3 items(uint32_t(scene_.camera.width), uint32_t(scene_.camera.height), 1u);
   std::vector<std::string> labels;
   uint32_t finalSet = 0;
@@ -205,13 +206,15 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
     const uint32_t hist = history_;
     uint32_t cur = (hist + 1) % kSets;
     shared::RsPush push{};
-    push.sets = glm::uvec4(0u, 0u, cur, 0u);
+    push.outSet = cur;
     candidates_->record(cmd, items, &push, &timer_);
     labels.push_back("candidates");
     gpu::computeBarrier(cmd);
     if (temporal) {
       const uint32_t out = (hist + 2) % kSets;
-      push.sets = glm::uvec4(cur, hist, out, 0u);
+      push.inSet = cur;
+      push.historySet = hist;
+      push.outSet = out;
       temporal_->record(cmd, items, &push, &timer_);
       labels.push_back("temporal");
       gpu::computeBarrier(cmd);
@@ -219,15 +222,20 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
     }
     for (int r = 0; r < options_.rounds; ++r) {
       const uint32_t out = (cur + 1) % kSets;
-      push.sets = glm::uvec4(cur, cur, out, 0u);
-      push.misc = glm::uvec4(uint32_t(r), 0u, 0u, 0u);
+      push.inSet = cur;
+      push.historySet = cur;
+      push.outSet = out;
+      push.spatialRound = uint32_t(r);
       spatial_->record(cmd, items, &push, &timer_);
       labels.push_back(strf("spatial %d", r + 1));
       gpu::computeBarrier(cmd);
       cur = out;
     }
-    push.sets = glm::uvec4(cur, cur, cur, 0u);
-    push.misc = glm::uvec4(0u, accumulate ? 0u : 1u, 0u, 0u);
+    push.inSet = cur;
+    push.historySet = cur;
+    push.outSet = cur;
+    push.spatialRound = 0u;
+    push.restartAccumulation = accumulate ? 0u : 1u;
     shade_->record(cmd, items, &push, &timer_);
     labels.push_back("shade");
     finalSet = cur;

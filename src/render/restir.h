@@ -75,7 +75,7 @@ class Restir {
   FeatureSet features_;
   std::unique_ptr<gpu::ComputePass> candidates_, temporal_, spatial_, shade_;
   gpu::GpuTimer timer_;
-  gpu::Buffer frameBuffer_, lightBuffer_, paramBuffer_, reservoirs_, paths_, bounces_, output_, counters_;
+  gpu::Buffer frameBuffer_, lightBuffer_, lightChoice_, paramBuffer_, reservoirs_, paths_, bounces_, output_, counters_;
   shared::GpuFrame frame_{};
   shared::RestirParams params_{};
   uint32_t history_ = 0;
@@ -83,7 +83,7 @@ class Restir {
   uint32_t prevSequence_ = 0;
   uint64_t currentSerial_ = 0, previousSerial_ = 0;  // volumes given to setVolumes
   uint64_t renderedSerial_ = 0;                      // the volume the history was rendered with
-  glm::vec4 prevCam_[4]{};
+  shared::GpuCamera prevCam_{};
   glm::vec3 centre_{0.0f};  // world centre of the volume's bounds (reprojection depth)
   PassTimes passTimes_;
 };

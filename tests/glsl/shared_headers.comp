@@ -15,6 +15,15 @@
 #include "shared/dda.h"
 #include "shared/gpu_types.h"
 #include "shared/restir_types.h"
+#include "shared/bindings.h"
+
+// restir_mis.h reads its inputs through accessor macros (here: small tables).
+float misM[3];
+float misTargets[9];
+#define RS_MIS_M(j) misM[j]
+#define RS_MIS_OWN_TARGET(s) misTargets[(s) * 3u + (s)]
+#define RS_MIS_TARGET(s, j) misTargets[(s) * 3u + (j)]
+#include "shared/restir_mis.h"
 
 layout(local_size_x = 64) in;
 
@@ -28,6 +37,8 @@ layout(std430, binding = 2) readonly buffer Params {
   GpuVolume volume;
   GpuFrame frame;
   GpuLight lights[GPU_MAX_LIGHTS];
+  GpuLightChoice choice[GPU_MAX_LIGHTS];
+  RestirParams rsParams;
 };
 
 void main() {
@@ -68,12 +79,11 @@ void main() {
   float t0 = 0.0f;
   float t1 = 0.0f;
   ivec3 cell = ivec3(0);
-  if (dda_init(dda, vec3(0.5f), wo, 0.0f, DDA_INF, volume.boundsMin.xyz, 8.0f,
-               volume.brickDims.xyz)) {
+  if (dda_init(dda, vec3(0.5f), wo, 0.0f, DDA_INF, volume.boundsMin, 8.0f, volume.brickDims)) {
     dda_next(dda, t0, t1, cell);
   }
-  s += vec3(cell) * (t1 - t0) + frame.albedo.xyz + lights[0].emission.xyz;
-  s += cam_direction(vec2(0.5f), frame.image.xy, frame.camPosition, frame.camForward, frame.camRight, frame.camUp);
+  s += vec3(cell) * (t1 - t0) + frame.albedo + lights[0].emission + vec3(choice[0].probability, choice[0].cdf, float(BIND_LIGHT_CHOICE));
+  s += cam_direction(vec2(0.5f), frame.size, frame.camera) + rsParams.prevCamera.position;
   // accumulate.h
   vec4 acc = vec4(0.0f);
   vec3 m2 = vec3(0.0f);
@@ -84,6 +94,9 @@ void main() {
   float mis = rs_pairwise_neighbour(1.0f, p, 2.0f, pc, 3.0f) + rs_pairwise_canonical_term(1.0f, p, 2.0f, pc, 3.0f) +
               rs_pair_share(1.0f, p, 1.0f, pc) + rs_gbh(1.0f, p, 2.0f) +
               float(RS_MAX_VERTICES + RS_MAX_NEIGHBOURS + RS_MIS_PAIRWISE + RS_MIS_GBH + RS_MIS_BIASED);
+  for (uint k = 0u; k < 9u; ++k) misTargets[k] = p + float(k);
+  for (uint k = 0u; k < 3u; ++k) misM[k] = 1.0f + float(k);
+  mis += rs_mis_weight(RS_MIS_PAIRWISE, 1u, 3u, 6.0f, pc) + rs_mis_weight(RS_MIS_GBH, 0u, 3u, 6.0f, pc);
   s += wd * mis;
   values[i] = vec4(s + wo, t + m + (picked ? 1.0f : 0.0f) + (dropped ? 2.0f : 0.0f) +
                    (rs_is_finite(back.W) ? back.W : 0.0f));

@@ -1,0 +1,86 @@
+// The GPU baseline (DESIGN §4.1): unidirectional volumetric path tracing, delta tracking for
+// free flights, next-event estimation with ratio tracking to every light, phase sampling, Russian
+// roulette. `frame.spp` samples per pixel per dispatch, merged into a running mean and M2 per
+// pixel (Chan et al.'s parallel variance update) so progressive batches give the variance of the
+// mean. Variant defines: PLUME_HAS_SUN, PLUME_HAS_POINT, PLUME_HAS_ENV, PLUME_MULTI_BOUNCE.
+// Requires volume/bindings.glsl, scene/bindings.glsl and ptAccum (shaders/passes/pt.comp).
+#ifndef PLUME_PT_INTEGRATOR_GLSL
+#define PLUME_PT_INTEGRATOR_GLSL
+
+#include "../shared/accumulate.h"
+#include "../volume/grid.glsl"
+#include "../volume/walk.glsl"
+#include "../light/light.glsl"
+#include "../integrator/vertex.glsl"
+
+// Next-event estimation at a vertex x of a path arriving along rayDir: one sample per light.
+vec3 pt_direct(uint kind, vec3 x, vec3 rayDir, inout RngState rng) {
+  vec3 sum = vec3(0.0f);
+  for (uint i = 0u; i < frame.lightCount; ++i) {
+    GpuLight l = lights[i];
+    vec2 u = vec2(0.0f);
+    if (light_samples_direction(l)) u = rng_float2(rng);
+    vec3 w;
+    float dist;
+    vec3 Le;
+    if (!light_connect(l, x, light_sample_dir(l, x, rayDir, frame.g, u), w, dist, Le)) continue;
+    float tr = vol_ratio_tracking(x, w, dist, rng);
+    sum += Le * vtx_scatter(kind, rayDir, w) * tr / light_pdf(l, w, rayDir, frame.g);
+  }
+  return sum;
+}
+
+vec3 pt_trace_path(vec3 origin, vec3 dir, inout RngState rng) {
+  vec3 radiance = vec3(0.0f);
+  vec3 beta = vec3(1.0f);
+#ifdef PLUME_MULTI_BOUNCE
+  for (uint scatterings = 0u;;) {
+#else
+  {
+    uint scatterings = 0u;
+#endif
+    float t;
+    if (!vol_sample_collision(origin, dir, DDA_INF, rng, t)) {
+      // Lights are reached by NEE after the first vertex: only camera rays see the environment.
+      if (scatterings == 0u) radiance += beta * light_escaped(dir);
+      return radiance;
+    }
+    if (++scatterings > frame.maxBounces) return radiance;
+    vec3 x = origin + t * dir;
+    beta *= vtx_albedo(VERTEX_MEDIUM);  // delta tracking's collision weight
+    radiance += beta * pt_direct(VERTEX_MEDIUM, x, dir, rng);
+#ifdef PLUME_MULTI_BOUNCE
+    if (scatterings >= frame.rrStartBounce) {
+      float q = min(1.0f, plume_max3(beta));
+      if (rng_float(rng) >= q) return radiance;
+      beta /= q;
+    }
+    dir = normalize(vtx_sample(VERTEX_MEDIUM, dir, rng_float2(rng)));
+    origin = x;
+#endif
+  }
+  return radiance;
+}
+
+// All of a dispatch's samples of one pixel, merged into the accumulation.
+void pt_render_pixel(uvec2 pixel) {
+  uint index = pixel.y * frame.size.x + pixel.x;
+  vec4 batch = vec4(0.0f);  // (mean, n) of this dispatch's samples, and their M2
+  vec3 m2 = vec3(0.0f);
+  for (uint s = 0u; s < frame.spp; ++s) {
+    uint sampleIndex = frame.firstSample + s;
+    RngState rng = rng_init(pixel, frame.frameKey, RNG_STREAM_PATH + (sampleIndex << 8u), frame.seed);
+    vec2 u = rng_float2(rng);
+    // Box filter, row 0 at the top (DESIGN §2).
+    vec3 dir = normalize(cam_direction(vec2(pixel) + u, frame.size, frame.camera));
+    vec3 L = pt_trace_path(frame.camera.position, dir, rng);
+    acc_merge(batch, m2, L, vec3(0.0f), 1.0f);
+  }
+  vec4 a = ptAccum[2u * index];
+  vec3 m2a = ptAccum[2u * index + 1u].rgb;
+  acc_merge(a, m2a, batch.rgb, m2, batch.w);
+  ptAccum[2u * index] = a;
+  ptAccum[2u * index + 1u] = vec4(m2a, 0.0f);
+}
+
+#endif

@@ -1,0 +1,43 @@
+// Binding numbers of every compute pass, named once for C++ and GLSL (in the manner of RTXDI's
+// RAB_Buffers): the shaders declare `layout(binding = BIND_...)`, the host binds by the same name.
+// Each estimator declares its own buffers and nothing else; numbers may repeat across estimators.
+#ifndef PLUME_SHARED_BINDINGS_H
+#define PLUME_SHARED_BINDINGS_H
+
+#include "common.h"
+
+PLUME_NS_BEGIN
+
+// The baked volume (shaders/volume/bindings.glsl; render/gpu_volume.cpp), every volume pass.
+const uint BIND_VOLUME = 0u;           // GpuVolume
+const uint BIND_ATLAS = 1u;            // sampler3D: the brick atlas
+const uint BIND_INDIRECTION = 2u;      // uint[]: packed slot coordinates per brick
+const uint BIND_MAJORANTS = 3u;        // float[]: the majorant hierarchy
+const uint BIND_VOLUME_COUNTERS = 4u;  // uint[]: [0] tracking loops truncated by the step cap
+
+// The scene, every estimator.
+const uint BIND_FRAME = 5u;            // GpuFrame
+const uint BIND_LIGHTS = 6u;           // GpuLight[]
+
+// The path tracer (shaders/passes/pt.comp).
+const uint BIND_PT_ACCUM = 7u;         // per pixel: vec4(mean rgb, n), vec4(M2 rgb, 0)
+
+// ReSTIR (shaders/restir/bindings.glsl): its parameters, the current volume's mean field, the
+// previous frame's volume (temporal reuse evaluates the history's target with it), reservoirs.
+const uint BIND_RS_PARAMS = 7u;        // RestirParams
+const uint BIND_MEAN_FIELD = 8u;       // uint[]: per voxel float16 mean and residual bound
+const uint BIND_PREV_VOLUME = 9u;
+const uint BIND_PREV_ATLAS = 10u;
+const uint BIND_PREV_INDIRECTION = 11u;
+const uint BIND_PREV_MEAN_FIELD = 12u;
+const uint BIND_RS_RESERVOIRS = 13u;   // RsPacked[set * pixels + pixel]
+const uint BIND_RS_PATHS = 14u;        // RsPathHead[set * pixels + pixel]
+const uint BIND_RS_BOUNCES = 15u;      // vec4(w_i, t_i) of vertices 2..n
+const uint BIND_RS_OUTPUT = 16u;       // accumulation of final shading (as BIND_PT_ACCUM)
+const uint BIND_RS_COUNTERS = 17u;     // uint[]: [0] reservoirs dropped for non-finite weights
+const uint BIND_LIGHT_CHOICE = 18u;    // GpuLightChoice[]
+const uint RS_BINDING_COUNT = 19u;
+
+PLUME_NS_END
+
+#endif

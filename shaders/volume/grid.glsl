@@ -1,0 +1,117 @@
+// The one lookup into a baked volume (DESIGN §3): trilinear density with exact weights
+// (8 texelFetch), per-brick majorants and ReSTIR's per-voxel mean field, for the current volume
+// or the previous frame's (temporal reuse), chosen by a parameter `v` (VOL_CURRENT,
+// VOL_PREVIOUS), never by a copy of the code. Mirrors media/bake_lookup.cpp texel for texel.
+// Requires volume/bindings.glsl.
+#ifndef PLUME_VOLUME_GRID_GLSL
+#define PLUME_VOLUME_GRID_GLSL
+
+const int VOL_BRICK = 8;     // voxels per brick edge
+const int VOL_TEXELS = 10;   // atlas texels per slot edge (the brick and a one-voxel apron)
+const uint VOL_BRICK_VOXELS = 512u;  // mean-field words per atlas slot
+
+const uint VOL_CURRENT = 0u;
+const uint VOL_PREVIOUS = 1u;
+
+// A field of volume v's parameter block. Without the previous volume bound (the path tracer),
+// v is ignored and the current one is read.
+#ifdef PLUME_VOL_PREVIOUS
+#define VOL_PARAM(v, field) ((v) == VOL_CURRENT ? vol.field : prevVol.field)
+#else
+#define VOL_PARAM(v, field) (vol.field)
+#endif
+
+uint vol_indirection(uint v, uint i) {
+#ifdef PLUME_VOL_PREVIOUS
+  if (v != VOL_CURRENT) return prevIndirection[i];
+#endif
+  return volIndirection[i];
+}
+
+float vol_texel(uint v, ivec3 t) {
+#ifdef PLUME_VOL_PREVIOUS
+  if (v != VOL_CURRENT) return texelFetch(prevAtlas, t, 0).r;
+#endif
+  return texelFetch(volAtlas, t, 0).r;
+}
+
+// The indirection holds each brick's atlas slot as packed slot coordinates (10 bits per axis,
+// see GpuVolumeResources); 0 is the all-zero slot. No integer division in the hot loop.
+uint vol_packed_slot(uint v, ivec3 brick) {
+  ivec3 dims = VOL_PARAM(v, brickDims);
+  ivec3 r = brick - VOL_PARAM(v, brickOrigin);
+  if (any(lessThan(r, ivec3(0))) || any(greaterThanEqual(r, dims))) return 0u;
+  return vol_indirection(v, uint((r.z * dims.y + r.y) * dims.x + r.x));
+}
+
+ivec3 vol_slot_coords(uint packed) {
+  return ivec3(int(packed & 1023u), int((packed >> 10u) & 1023u), int(packed >> 20u));
+}
+
+// Density d at an index-space point (not yet multiplied by the density scale).
+float vol_density(uint v, vec3 p) {
+  vec3 fl = floor(p);
+  ivec3 vox = ivec3(fl);
+  ivec3 b = vox >> 3;
+  uint slot = vol_packed_slot(v, b);
+  if (slot == 0u) return 0.0f;
+  vec3 f = p - fl;
+  ivec3 t = vol_slot_coords(slot) * VOL_TEXELS + (vox - b * VOL_BRICK) + 1;
+  float sum = 0.0f;
+  for (int c = 0; c < 8; ++c) {
+    ivec3 o = ivec3(c & 1, (c >> 1) & 1, (c >> 2) & 1);
+    float w = (o.x != 0 ? f.x : 1.0f - f.x) * (o.y != 0 ? f.y : 1.0f - f.y) * (o.z != 0 ? f.z : 1.0f - f.z);
+    sum += w * vol_texel(v, t + o);
+  }
+  return sum;
+}
+
+float vol_scale(uint v) { return VOL_PARAM(v, densityScale); }
+bool vol_is_empty(uint v) { return VOL_PARAM(v, empty) != 0; }
+
+// sigma_t at an index-space point.
+float vol_sigma_t(uint v, vec3 indexPos) { return vol_scale(v) * vol_density(v, indexPos); }
+
+// The world ray mapped to index space; t stays in world units.
+void vol_ray_to_index(uint v, vec3 oWorld, vec3 dWorld, out vec3 o, out vec3 d) {
+  mat4 m = VOL_PARAM(v, worldToIndex);
+  o = (m * vec4(oWorld, 1.0f)).xyz;
+  d = (m * vec4(dWorld, 0.0f)).xyz;
+}
+
+// sigma_t at a world point (0 for an empty volume).
+float vol_sigma_t_world(uint v, vec3 xWorld) {
+  if (vol_is_empty(v)) return 0.0f;
+  vec3 o;
+  vec3 d;
+  vol_ray_to_index(v, xWorld, vec3(0.0f), o, d);
+  return vol_sigma_t(v, o);
+}
+
+// Majorant of sigma_t in a cell of level `level` of the current volume's hierarchy (level 0:
+// per brick; cells relative to brickOrigin). Only the current volume is tracked against majorants.
+float vol_level_max(int level, ivec3 cell) {
+  ivec3 dims = vol.levels[level].cells;
+  return volMajorants[vol.levelOffset[level] + uint((cell.z * dims.y + cell.y) * dims.x + cell.x)];
+}
+float vol_brick_majorant(ivec3 cell) { return vol.densityScale * vol_level_max(0, cell); }
+
+#if defined(PLUME_VOL_MEAN_FIELD) || defined(PLUME_VOL_PREVIOUS)
+// First mean-field word of the brick in packed slot `slot` (slot index x + X * (y + Y * z)).
+uint vol_mean_field_base(uint v, uint slot) {
+  ivec3 slots = VOL_PARAM(v, atlasSlots);
+  ivec3 s = vol_slot_coords(slot);
+  return (uint(s.x) + uint(slots.x) * (uint(s.y) + uint(slots.y) * uint(s.z))) * VOL_BRICK_VOXELS;
+}
+
+// (mean, residual bound) of the density in mean-field voxel i (bake.h packedMeanField): the mean
+// of the trilinear density over the voxel and a bound on the density's deviation from it.
+vec2 vol_mean_field(uint v, uint i) {
+#ifdef PLUME_VOL_PREVIOUS
+  if (v != VOL_CURRENT) return unpackHalf2x16(prevMeanField[i]);
+#endif
+  return unpackHalf2x16(volMeanField[i]);
+}
+#endif
+
+#endif

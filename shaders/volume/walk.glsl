@@ -1,0 +1,301 @@
+// The one majorant walk (in the spirit of pbrt-v4's SampleT_maj): a ray is cut into segments of
+// a piecewise-constant field, and every tracker — delta tracking, ratio tracking, residual ratio
+// tracking, the mean field's optical depth and closed-form sampling — is this one loop with its
+// own "callbacks": what to do on entering a segment (vol_track_segment) and at each tentative
+// collision of the Poisson process of rate mu it asks for there (vol_track_event). The tracker is
+// a constant at every call site, so each inlined copy holds only its own code (a SIMD back end
+// such as lavapipe runs both sides of an `if` otherwise: ../shared/docs/LAVAPIPE.md).
+//
+// Two fields:
+//  - VOL_FIELD_MAJORANT: per-brick majorants of sigma_t, a DDA over the bricks; with
+//    PLUME_SKIP_EMPTY an outer DDA over level-1 cells (4³ bricks) skips empty ones and an inner
+//    DDA walks the bricks of the others (it pays on large sparse volumes; on small ones its
+//    bookkeeping costs more than it saves, +35% on the bundled smoke with lavapipe, so the host
+//    picks the variant from the size of the brick grid: render/path_tracer.cpp);
+//  - VOL_FIELD_MEAN: ReSTIR's per-voxel mean field, an outer DDA over bricks (an empty brick is
+//    one step) and an inner one over the voxels of each occupied brick.
+// Requires volume/bindings.glsl and volume/grid.glsl.
+#ifndef PLUME_VOLUME_WALK_GLSL
+#define PLUME_VOLUME_WALK_GLSL
+
+#include "../shared/dda.h"
+#include "../shared/rng.h"
+
+const uint VOL_MAX_STEPS = 1u << 20;  // per tracking call; hits are counted in volCounters[0]
+const float VOL_MAX_TAU = 80.0f;      // the mean field's optical depth is clamped here: exp(-80) > 0
+
+const uint VOL_FIELD_MAJORANT = 0u;
+const uint VOL_FIELD_MEAN = 1u;
+
+// --- Segments of a field along a ray ---------------------------------------------------------------
+struct VolWalk {
+  DdaState outer;
+  DdaState inner;
+  bool innerLive;
+  uint v;
+  ivec3 outerCell;
+  uint base;   // VOL_FIELD_MEAN: the current brick's first mean-field word
+  vec3 o;
+  vec3 d;
+};
+
+bool vol_walk_start(uint field, uint v, vec3 o, vec3 d, float tMax, out VolWalk w) {
+  w.innerLive = false;
+  w.v = v;
+  w.outerCell = ivec3(0);
+  w.base = 0u;
+  w.o = o;
+  w.d = d;
+  if (field == VOL_FIELD_MAJORANT) {
+#ifdef PLUME_SKIP_EMPTY
+    if (vol.empty != 0 || vol.levelCount < 2u) return false;  // empty (or no level 1: host bug)
+    return dda_init(w.outer, o, d, 0.0f, tMax, vec3(vol.brickOrigin * VOL_BRICK),
+                    float(VOL_BRICK * vol.levels[1].bricksPerCell), vol.levels[1].cells);
+#else
+    if (vol.empty != 0) return false;
+    return dda_init(w.outer, o, d, 0.0f, tMax, vec3(vol.brickOrigin * VOL_BRICK), float(VOL_BRICK),
+                    vol.levels[0].cells);
+#endif
+  }
+  if (vol_is_empty(v)) return false;
+  return dda_init(w.outer, o, d, 0.0f, tMax, vec3(VOL_PARAM(v, brickOrigin) * VOL_BRICK), float(VOL_BRICK),
+                  VOL_PARAM(v, brickDims));
+}
+
+// The next segment [a, b) and the field's value there: VOL_FIELD_MAJORANT (sigma_t majorant, 0);
+// VOL_FIELD_MEAN (sigma_t of the voxel mean, sigma_t bound of the residual). Segments come in
+// order; the field is 0 between them.
+bool vol_walk_next(uint field, inout VolWalk w, out float a, out float b, out vec2 value) {
+  a = 0.0f;
+  b = 0.0f;
+  value = vec2(0.0f);
+#ifndef PLUME_SKIP_EMPTY
+  if (field == VOL_FIELD_MAJORANT) {
+    ivec3 cell;
+    bool more = dda_next(w.outer, a, b, cell);
+    value.x = more ? vol_brick_majorant(cell) : 0.0f;
+    return more;
+  }
+#endif
+  for (;;) {
+    if (w.innerLive) {
+      ivec3 sub;
+      if (dda_next(w.inner, a, b, sub)) {
+        if (field == VOL_FIELD_MAJORANT) {
+          value.x = vol_brick_majorant(w.outerCell * vol.levels[1].bricksPerCell + sub);
+        } else {
+#if defined(PLUME_VOL_MEAN_FIELD) || defined(PLUME_VOL_PREVIOUS)
+          value = vol_scale(w.v) * vol_mean_field(w.v, w.base + uint((sub.z * VOL_BRICK + sub.y) * VOL_BRICK + sub.x));
+#endif
+        }
+        return true;
+      }
+      w.innerLive = false;
+    }
+    float oa;
+    float ob;
+    ivec3 cell;
+    if (!dda_next(w.outer, oa, ob, cell)) return false;
+    if (field == VOL_FIELD_MAJORANT) {
+      if (vol_level_max(1, cell) <= 0.0f) continue;
+      int n = vol.levels[1].bricksPerCell;
+      w.outerCell = cell;
+      ivec3 dims = min(ivec3(n), vol.levels[0].cells - cell * n);
+      w.innerLive = dda_init(w.inner, w.o, w.d, oa, ob, vec3((vol.brickOrigin + cell * n) * VOL_BRICK),
+                             float(VOL_BRICK), dims);
+    } else {
+#if defined(PLUME_VOL_MEAN_FIELD) || defined(PLUME_VOL_PREVIOUS)
+      ivec3 brick = VOL_PARAM(w.v, brickOrigin) + cell;
+      uint slot = vol_packed_slot(w.v, brick);
+      if (slot == 0u) continue;
+      w.base = vol_mean_field_base(w.v, slot);
+      w.innerLive = dda_init(w.inner, w.o, w.d, oa, ob, vec3(brick * VOL_BRICK), 1.0f, ivec3(VOL_BRICK));
+#endif
+    }
+  }
+  return false;
+}
+
+// --- Trackers ------------------------------------------------------------------------------------
+const uint VOL_TRACK_DELTA = 0u;     // delta tracking (Woodcock): the first real collision
+const uint VOL_TRACK_RATIO = 1u;     // ratio tracking: an unbiased transmittance estimate
+const uint VOL_TRACK_RESIDUAL = 2u;  // residual ratio tracking against the mean field (unbiased)
+const uint VOL_TRACK_TAU = 3u;       // the mean field's optical depth (deterministic)
+const uint VOL_TRACK_SAMPLE = 4u;    // a collision in the mean field, pdf in closed form
+
+struct VolTrack {
+  float value;  // RATIO, RESIDUAL: the transmittance estimate; TAU: the optical depth;
+                // SAMPLE: the optical depth still to go
+  float t;      // DELTA, SAMPLE: the collision's distance (tMax without one)
+  float sigma;  // SAMPLE: the mean field's sigma_t at the collision
+  bool hit;     // DELTA, SAMPLE: a collision was found
+  bool stop;    // the walk ends now (a hit, a transmittance ended by roulette, the step cap)
+};
+
+// Russian roulette on a transmittance estimate (unbiased): below VOL_RR_TRANSMITTANCE it
+// survives with probability |T| / VOL_RR_TRANSMITTANCE and is raised to that value, so an
+// estimate that can only add a little stops early instead of walking through the rest of a dense
+// medium, and a survivor's weight stays bounded.
+const float VOL_RR_TRANSMITTANCE = 0.01f;
+bool vol_transmittance_roulette(inout float tr, inout RngState rng) {
+  float m = abs(tr);
+  if (!(m < VOL_RR_TRANSMITTANCE)) return true;
+  if (rng_float(rng) * VOL_RR_TRANSMITTANCE >= m) return false;
+  tr = tr < 0.0f ? -VOL_RR_TRANSMITTANCE : VOL_RR_TRANSMITTANCE;
+  return true;
+}
+
+#ifndef PLUME_RS_RESIDUAL_SCALE
+#define PLUME_RS_RESIDUAL_SCALE 1.0f
+#endif
+
+// Whether the walk goes on to the next segment.
+bool vol_track_alive(uint tracker, VolTrack s) {
+  if (s.stop) return false;
+  if (tracker == VOL_TRACK_RATIO) return s.value > 0.0f;
+  if (tracker == VOL_TRACK_RESIDUAL) return s.value != 0.0f;
+  if (tracker == VOL_TRACK_TAU) return s.value < VOL_MAX_TAU;
+  return !s.hit;
+}
+
+// On entering segment [a, b) with field value `value`: returns the rate of the tentative
+// collisions the tracker wants there (0: none).
+float vol_track_segment(uint tracker, inout VolTrack s, float a, float b, vec2 value) {
+  if (tracker == VOL_TRACK_DELTA || tracker == VOL_TRACK_RATIO) return value.x;  // the majorant
+  if (tracker == VOL_TRACK_RESIDUAL) {
+    // The control's transmittance in closed form, the residual by ratio tracking at mu.
+    s.value *= exp(-value.x * (b - a));
+    return PLUME_RS_RESIDUAL_SCALE * value.y;
+  }
+  if (tracker == VOL_TRACK_TAU) {
+    s.value += value.x * (b - a);
+    return 0.0f;
+  }
+  // VOL_TRACK_SAMPLE: every collision of a piecewise-constant field at its own value is real.
+  float dtau = value.x * (b - a);
+  if (value.x > 0.0f && dtau >= s.value) {
+    s.t = a + s.value / value.x;
+    s.sigma = value.x;
+    s.hit = true;
+  } else {
+    s.value -= dtau;
+  }
+  return 0.0f;
+}
+
+// At a tentative collision at distance t (index-space point p) of rate mu, in a segment of field
+// value `value`; u is a uniform number drawn with the step.
+void vol_track_event(uint tracker, inout VolTrack s, uint v, vec3 p, float t, float mu, vec2 value, float u,
+                     inout RngState rng) {
+  if (tracker == VOL_TRACK_DELTA) {
+    if (u * mu < vol_sigma_t(v, p)) {
+      s.t = t;
+      s.hit = true;
+      s.stop = true;
+    }
+  } else if (tracker == VOL_TRACK_RATIO) {
+    s.value *= max(0.0f, 1.0f - vol_sigma_t(v, p) / mu);
+    if (!vol_transmittance_roulette(s.value, rng)) {
+      s.value = 0.0f;
+      s.stop = true;
+    }
+  } else if (tracker == VOL_TRACK_RESIDUAL) {
+    s.value *= 1.0f - (vol_sigma_t(v, p) - value.x) / mu;
+  }
+}
+
+// The walk. `init`: the tracker's starting value (RATIO, RESIDUAL 1; TAU 0; SAMPLE the optical
+// depth to the collision). Tentative collisions restart at each segment's entry (exponential
+// steps are memoryless); each step draws one rng_next4 (its x: the step, its y: the event's u).
+VolTrack vol_track(uint tracker, uint v, vec3 xWorld, vec3 wWorld, float tMax, float init, inout RngState rng) {
+  VolTrack s;
+  s.value = init;
+  s.t = tMax;
+  s.sigma = 0.0f;
+  s.hit = false;
+  s.stop = false;
+  uint field = tracker <= VOL_TRACK_RATIO ? VOL_FIELD_MAJORANT : VOL_FIELD_MEAN;
+  vec3 o;
+  vec3 d;
+  vol_ray_to_index(v, xWorld, wWorld, o, d);
+  VolWalk w;
+  if (!vol_walk_start(field, v, o, d, tMax, w)) return s;
+  uint steps = 0u;
+  float a;
+  float b;
+  vec2 value;
+  while (vol_track_alive(tracker, s) && vol_walk_next(field, w, a, b, value)) {
+    float mu = vol_track_segment(tracker, s, a, b, value);
+    if (!(mu > 0.0f)) continue;
+    float t = a;
+    for (;;) {
+      if (++steps > VOL_MAX_STEPS) {
+        s.stop = true;
+        break;
+      }
+      uvec4 h = rng_next4(rng);
+      t -= log(1.0f - rng_to_float(h.x)) / mu;
+      if (!(t < b)) break;
+      vol_track_event(tracker, s, v, o + t * d, t, mu, value, rng_to_float(h.y), rng);
+      if (s.stop) break;
+    }
+  }
+  if (steps > VOL_MAX_STEPS) atomicAdd(volCounters[0], 1u);  // truncated: counted, never silent
+  return s;
+}
+
+// --- The trackers by name ------------------------------------------------------------------------
+// Delta tracking: the first real collision along the world ray in (0, tMax).
+bool vol_sample_collision(vec3 oWorld, vec3 dWorld, float tMax, inout RngState rng, out float tHit) {
+  VolTrack s = vol_track(VOL_TRACK_DELTA, VOL_CURRENT, oWorld, dWorld, tMax, 0.0f, rng);
+  tHit = s.t;
+  return s.hit;
+}
+
+// Ratio tracking: an unbiased estimate of the transmittance over (0, tMax), with Russian
+// roulette once it is small (vol_transmittance_roulette).
+float vol_ratio_tracking(vec3 oWorld, vec3 dWorld, float tMax, inout RngState rng) {
+  return vol_track(VOL_TRACK_RATIO, VOL_CURRENT, oWorld, dWorld, tMax, 1.0f, rng).value;
+}
+
+#if defined(PLUME_VOL_MEAN_FIELD) || defined(PLUME_VOL_PREVIOUS)
+// Optical depth of the mean field over (0, tMax) along a world ray in volume v (deterministic;
+// approximates the fine optical depth, not a bound; stops once past VOL_MAX_TAU).
+float vol_mean_tau(uint v, vec3 xWorld, vec3 wWorld, float tMax) {
+  RngState unused = RngState(uvec4(0u), 0u);  // never drawn from: TAU asks for no collisions
+  return vol_track(VOL_TRACK_TAU, v, xWorld, wWorld, tMax, 0.0f, unused).value;
+}
+
+// The cheap deterministic strictly positive transmittance of ReSTIR's target function.
+float vol_mean_tr(uint v, vec3 xWorld, vec3 wWorld, float tMax) {
+  return exp(-min(vol_mean_tau(v, xWorld, wWorld, tMax), VOL_MAX_TAU));
+}
+
+// Tracking in the current volume's mean field: in a piecewise-constant medium the majorant
+// equals the density, so every tentative collision is real and the free-flight pdf is
+// sigmaC * exp(-tau) in closed form. False (probability exp(-tau_c(0, tMax))) when the ray
+// leaves first. tau, the optical depth to the collision, is also the target's transmittance of
+// the segment, so a candidate marches each segment once (tau <= -log(2^-24) ~ 16.6: the pdf
+// never underflows).
+bool vol_mean_sample(vec3 xWorld, vec3 wWorld, float tMax, float u, out float t, out float sigmaC, out float tau) {
+  tau = -log(1.0f - u);
+  RngState unused = RngState(uvec4(0u), 0u);  // never drawn from: SAMPLE is closed form
+  VolTrack s = vol_track(VOL_TRACK_SAMPLE, VOL_CURRENT, xWorld, wWorld, tMax, tau, unused);
+  t = s.t;
+  sigmaC = s.sigma;
+  return s.hit;
+}
+
+// Unbiased transmittance on the current volume's fine grid by residual ratio tracking (Novák et
+// al. 2014) with the mean field as control: T = exp(-tau_mean) * prod_i (1 - (sigma(x_i) -
+// sigma_mean(x_i)) / mu), the points x_i a Poisson process of rate mu = PLUME_RS_RESIDUAL_SCALE
+// times the cell's residual majorant. Its ratio to the target's exp(-tau_mean) is the product
+// alone, with relative variance exp(int r² / mu) - 1 for the residual r: final shading's f / p̂
+// stays near 1 where the mean field is close to the fine one, at a cost proportional to the
+// residual's optical depth instead of the density's.
+float vol_residual_tr(vec3 xWorld, vec3 wWorld, float tMax, inout RngState rng) {
+  return vol_track(VOL_TRACK_RESIDUAL, VOL_CURRENT, xWorld, wWorld, tMax, 1.0f, rng).value;
+}
+#endif
+
+#endif
