@@ -21,19 +21,16 @@ const uint VOL_PREVIOUS = 1u;
 #define VOL_PARAM(v, field) (vol.field)
 #endif
 
-uint vol_indirection(uint v, uint i) {
+// Selections between the two volumes' resources are plain ternaries (a select), with no control flow.
 #ifdef PLUME_VOL_PREVIOUS
-  if (v != VOL_CURRENT) return prevIndirection[i];
-#endif
-  return volIndirection[i];
-}
-
+uint vol_indirection(uint v, uint i) { return v == VOL_CURRENT ? volIndirection[i] : prevIndirection[i]; }
 float vol_texel(uint v, ivec3 t) {
-#ifdef PLUME_VOL_PREVIOUS
-  if (v != VOL_CURRENT) return texelFetch(prevAtlas, t, 0).r;
-#endif
-  return texelFetch(volAtlas, t, 0).r;
+  return v == VOL_CURRENT ? texelFetch(volAtlas, t, 0).r : texelFetch(prevAtlas, t, 0).r;
 }
+#else
+uint vol_indirection(uint v, uint i) { return volIndirection[i]; }
+float vol_texel(uint v, ivec3 t) { return texelFetch(volAtlas, t, 0).r; }
+#endif
 
 // The indirection holds each brick's atlas slot as packed slot coordinates (10 bits per axis,
 // see GpuVolumeResources); 0 is the all-zero slot. No integer division in the hot loop.
@@ -108,9 +105,10 @@ uint vol_mean_field_base(uint v, uint slot) {
 // of the trilinear density over the voxel and a bound on the density's deviation from it.
 vec2 vol_mean_field(uint v, uint i) {
 #ifdef PLUME_VOL_PREVIOUS
-  if (v != VOL_CURRENT) return unpackHalf2x16(prevMeanField[i]);
-#endif
+  return unpackHalf2x16(v == VOL_CURRENT ? volMeanField[i] : prevMeanField[i]);
+#else
   return unpackHalf2x16(volMeanField[i]);
+#endif
 }
 #endif
 

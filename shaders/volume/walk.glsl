@@ -35,6 +35,7 @@ struct VolWalk {
   uint v;
   ivec3 outerCell;
   uint base;   // VOL_FIELD_MEAN: the current brick's first mean-field word
+  float scale; // VOL_FIELD_MEAN: the volume's density scale (read once, not per voxel)
   vec3 o;
   vec3 d;
 };
@@ -44,6 +45,7 @@ bool vol_walk_start(uint field, uint v, vec3 o, vec3 d, float tMax, out VolWalk 
   w.v = v;
   w.outerCell = ivec3(0);
   w.base = 0u;
+  w.scale = 0.0f;
   w.o = o;
   w.d = d;
   if (field == VOL_FIELD_MAJORANT) {
@@ -58,6 +60,7 @@ bool vol_walk_start(uint field, uint v, vec3 o, vec3 d, float tMax, out VolWalk 
 #endif
   }
   if (vol_is_empty(v)) return false;
+  w.scale = vol_scale(v);
   return dda_init(w.outer, o, d, 0.0f, tMax, vec3(VOL_PARAM(v, brickOrigin) * VOL_BRICK), float(VOL_BRICK),
                   VOL_PARAM(v, brickDims));
 }
@@ -85,7 +88,7 @@ bool vol_walk_next(uint field, inout VolWalk w, out float a, out float b, out ve
           value.x = vol_brick_majorant(w.outerCell * vol.levels[1].bricksPerCell + sub);
         } else {
 #if defined(PLUME_VOL_MEAN_FIELD) || defined(PLUME_VOL_PREVIOUS)
-          value = vol_scale(w.v) * vol_mean_field(w.v, w.base + uint((sub.z * VOL_BRICK + sub.y) * VOL_BRICK + sub.x));
+          value = w.scale * vol_mean_field(w.v, w.base + uint((sub.z * VOL_BRICK + sub.y) * VOL_BRICK + sub.x));
 #endif
         }
         return true;
@@ -240,7 +243,7 @@ VolTrack vol_track(uint tracker, uint v, vec3 xWorld, vec3 wWorld, float tMax, f
       if (s.stop) break;
     }
   }
-  if (steps > VOL_MAX_STEPS) atomicAdd(volCounters[0], 1u);  // truncated: counted, never silent
+  if (tracker <= VOL_TRACK_RATIO && steps > VOL_MAX_STEPS) atomicAdd(volCounters[0], 1u);  // counted, never silent
   return s;
 }
 
