@@ -243,7 +243,7 @@ VolTrack vol_track(uint tracker, uint v, vec3 xWorld, vec3 wWorld, float tMax, f
       if (s.stop) break;
     }
   }
-  if (tracker <= VOL_TRACK_RATIO && steps > VOL_MAX_STEPS) atomicAdd(volCounters[0], 1u);  // counted, never silent
+  if (steps > VOL_MAX_STEPS) atomicAdd(volCounters[0], 1u);  // truncated: counted, never silent
   return s;
 }
 
