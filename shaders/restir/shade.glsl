@@ -5,6 +5,8 @@
 #ifndef PLUME_RESTIR_SHADE_GLSL
 #define PLUME_RESTIR_SHADE_GLSL
 
+#include "../shared/accumulate.h"
+
 vec3 rs_shade(uvec2 pixel, uint pixelIndex, uint set) {
   RsDomain D = rs_current_domain(pixel);
   RngState rng = rng_init(pixel, frame.frameKey, RNG_STREAM_SHADING, frame.seed);
@@ -16,6 +18,23 @@ vec3 rs_shade(uvec2 pixel, uint pixelIndex, uint set) {
   L += light_escaped(dir) * vol_residual_tr(D.origin, dir, DDA_INF, rng);
 #endif
   return L;
+}
+
+// Final shading of `pixel` from reservoir set `set`, into the accumulation (restart: the first
+// sample of a new accumulation).
+void rs_shade_pixel(uvec2 pixel, uint set, bool restart) {
+  uint index = pixel.y * frame.size.x + pixel.x;
+  vec3 L = rs_shade(pixel, index, set);
+  if (restart) {
+    rsOutput[2u * index] = vec4(L, 1.0f);
+    rsOutput[2u * index + 1u] = vec4(0.0f);
+    return;
+  }
+  vec4 a = rsOutput[2u * index];
+  vec3 m2 = rsOutput[2u * index + 1u].rgb;
+  acc_merge(a, m2, L, vec3(0.0f), 1.0f);
+  rsOutput[2u * index] = a;
+  rsOutput[2u * index + 1u] = vec4(m2, 0.0f);
 }
 
 #endif
