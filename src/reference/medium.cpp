@@ -135,63 +135,54 @@ bool ReferenceMedium::nextSegment(Walk& w, double& t0, double& t1, double& major
   return true;
 }
 
-bool ReferenceMedium::sampleCollision(const Ray& ray, double tMax, Pcg32& rng, const Accessor& acc,
-                                      double& tHit, TrackingStats& stats) const {
+template <typename OnCollision>
+void ReferenceMedium::trackMajorants(const Ray& ray, double tMax, Pcg32& rng, const Accessor& acc,
+                                     TrackingStats& stats, OnCollision&& onCollision) const {
   Walk w;
-  if (!startWalk(ray, tMax, w)) return false;
+  if (!startWalk(ray, tMax, w)) return;
   uint64_t steps = 0;
-  bool hit = false;
   double a, b, maj;
-  while (!hit && nextSegment(w, a, b, maj)) {
+  bool going = true;
+  while (going && nextSegment(w, a, b, maj)) {
     if (maj <= 0.0) continue;
-    // Exponential steps are memoryless, so each segment restarts at its own entry point.
     for (double t = a;;) {
       if (++steps > kMaxTrackingSteps) {
         stats.truncated.fetch_add(1, std::memory_order_relaxed);
-        stats.steps.fetch_add(steps, std::memory_order_relaxed);
-        return false;
+        going = false;
+        break;
       }
       t -= std::log(1.0 - double(rng.uniform())) / maj;
       if (t >= b) break;
       const glm::dvec3 p = w.o + t * w.d;
-      const double sigma =
-          densityScale_ * openvdb::tools::BoxSampler::sample(acc, openvdb::Vec3R(p.x, p.y, p.z));
-      if (double(rng.uniform()) * maj < sigma) {  // real collision with probability sigma/maj
-        tHit = t;
-        hit = true;
+      const double sigma = densityScale_ * openvdb::tools::BoxSampler::sample(acc, openvdb::Vec3R(p.x, p.y, p.z));
+      if (!onCollision(t, sigma, maj)) {
+        going = false;
         break;
       }
     }
   }
   stats.steps.fetch_add(steps, std::memory_order_relaxed);
+}
+
+bool ReferenceMedium::sampleCollision(const Ray& ray, double tMax, Pcg32& rng, const Accessor& acc,
+                                      double& tHit, TrackingStats& stats) const {
+  bool hit = false;
+  trackMajorants(ray, tMax, rng, acc, stats, [&](double t, double sigma, double maj) {
+    if (!(double(rng.uniform()) * maj < sigma)) return true;  // a null collision: go on
+    tHit = t;  // real collision with probability sigma / maj
+    hit = true;
+    return false;
+  });
   return hit;
 }
 
 double ReferenceMedium::ratioTracking(const Ray& ray, double tMax, Pcg32& rng, const Accessor& acc,
                                       TrackingStats& stats) const {
-  Walk w;
-  if (!startWalk(ray, tMax, w)) return 1.0;
-  uint64_t steps = 0;
   double transmittance = 1.0;
-  double a, b, maj;
-  while (transmittance > 0.0 && nextSegment(w, a, b, maj)) {
-    if (maj <= 0.0) continue;
-    for (double t = a;;) {
-      if (++steps > kMaxTrackingSteps) {
-        stats.truncated.fetch_add(1, std::memory_order_relaxed);
-        stats.steps.fetch_add(steps, std::memory_order_relaxed);
-        return transmittance;
-      }
-      t -= std::log(1.0 - double(rng.uniform())) / maj;
-      if (t >= b) break;
-      const glm::dvec3 p = w.o + t * w.d;
-      const double sigma =
-          densityScale_ * openvdb::tools::BoxSampler::sample(acc, openvdb::Vec3R(p.x, p.y, p.z));
-      transmittance *= std::max(0.0, 1.0 - sigma / maj);  // ratio tracking weight per tentative collision
-      if (transmittance <= 0.0) break;
-    }
-  }
-  stats.steps.fetch_add(steps, std::memory_order_relaxed);
+  trackMajorants(ray, tMax, rng, acc, stats, [&](double, double sigma, double maj) {
+    transmittance *= std::max(0.0, 1.0 - sigma / maj);  // ratio tracking weight per tentative collision
+    return transmittance > 0.0;
+  });
   return transmittance;
 }
 

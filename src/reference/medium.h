@@ -61,6 +61,13 @@ class ReferenceMedium {
   struct Walk;
   bool startWalk(const Ray& ray, double tMax, Walk& walk) const;
   bool nextSegment(Walk& walk, double& t0, double& t1, double& majorant) const;
+  // The one majorant walk (pbrt-v4's SampleT_maj): the tentative collisions of each cell's
+  // majorant Poisson process (exponential steps, memoryless, so each cell restarts at its entry)
+  // handed to onCollision(t, sigma_t(t), majorant), which returns false to stop. Truncation by
+  // kMaxTrackingSteps is counted in stats and ends the walk (no silent caps).
+  template <typename OnCollision>
+  void trackMajorants(const Ray& ray, double tMax, Pcg32& rng, const Accessor& acc, TrackingStats& stats,
+                      OnCollision&& onCollision) const;
 
   openvdb::FloatGrid::ConstPtr grid_;
   float densityScale_;
