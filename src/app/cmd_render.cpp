@@ -8,6 +8,7 @@
 #include "gpu/shader_compiler.h"
 #include "media/bake.h"
 #include "media/vdb_loader.h"
+#include "media/volume_frames.h"
 #include "render/gpu_volume.h"
 #include "render/path_tracer.h"
 #include "render/restir.h"
@@ -173,7 +174,7 @@ class RestirFrames final : public FrameEstimator {
 int renderFrames(const RenderArgs& a, const Scene& scene, gpu::Context& ctx, FrameEstimator& estimator,
                  const BakeOptions& bakeOptions) {
   const RenderSettings& rs = scene.render;
-  const Medium& medium = scene.media.at(0);
+  const Medium& medium = scene.medium();
   const bool history = carriesHistory(rs.mode);
   struct Job {
     int frame;

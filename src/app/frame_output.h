@@ -3,7 +3,7 @@
 // settings in its header), EXR + optional PNG written atomically; and the progress display of a
 // frame sequence (bar with per-frame time and ETA on a terminal, one log line per frame otherwise).
 // Both commands compare a full render key (every setting the pixels depend on) and check up front
-// that the VDB file of every frame they are asked for is there.
+// that the VDB file of every frame they are asked for is there (media/volume_frames.h).
 #pragma once
 
 #include "app/settings_cli.h"
@@ -20,12 +20,6 @@
 #include <vector>
 
 namespace plume {
-
-// Throws InputError "<scene>: media[i].vdb: frame F: file not found: <path>" (or "not a regular
-// file", "cannot read") for the first frame in [first, last] whose VDB file of some medium cannot
-// be read, so that a sequence with a hole fails before hours of rendering rather than at the hole.
-// Frames --resume will skip are checked too: the range is what the job was asked for.
-void checkVolumeFrames(const Scene& scene, int first, int last);
 
 struct FrameOutputs {
   std::string pattern;  // -o value; {frame:04} replaced per frame

@@ -195,7 +195,7 @@ void checkReferenceSupports(const Scene& scene) {
 Image renderReference(const Scene& scene, openvdb::FloatGrid::ConstPtr density,
                       const ReferenceOptions& options, ReferenceStats* statsOut) {
   checkReferenceSupports(scene);
-  const Medium& m = scene.media.at(0);
+  const Medium& m = scene.medium();
   const RenderSettings& rs = scene.render;
   const Camera& cam = scene.camera;
   ReferenceMedium medium(density, m.densityScale);

@@ -71,7 +71,7 @@ uint64_t referenceKey(const Scene& s, int gridFrame) {
     return k != "mode" && k != "spp" && k != "seed" && k.rfind("restir_", 0) != 0;
   });
   std::error_code ec;
-  const fs::path vdb = s.media.at(0).vdbPath(gridFrame);
+  const fs::path vdb = s.medium().vdbPath(gridFrame);
   const auto size = fs::file_size(vdb, ec);
   const auto time = fs::last_write_time(vdb, ec).time_since_epoch().count();
   return fnv1a(render.text() + strf("|%llu|%lld", (unsigned long long)size, (long long)time));
@@ -223,7 +223,7 @@ BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Sce
   // the estimators, not the animation. Frame numbers count from it.
   const int first = o.gridFrame >= 0 ? o.gridFrame : scene.render.frameFirst;
   const int last = first + o.warmup + o.frames - 1;
-  const Medium& medium = scene.media.at(0);
+  const Medium& medium = scene.medium();
   LoadedGrid grid = loadFloatGrid(medium.vdbPath(first), medium.densityGrid);
   BakedVolume bake = bakeVolume(grid);
   GpuVolumeResources volume(ctx, bake, medium.densityScale);

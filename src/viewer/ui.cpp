@@ -130,7 +130,7 @@ void drawSettingsTable(ViewState& s, UiRequests& req) {
 }
 
 void drawMedium(ViewState& s, UiRequests& req) {
-  Medium& m = s.scene.media.at(0);
+  Medium& m = s.scene.medium();
   if (ImGui::SliderFloat("density scale", &m.densityScale, 0.0f, 200.0f, "%.2f", ImGuiSliderFlags_Logarithmic)) req.restart = true;
   if (ImGui::ColorEdit3("albedo", &m.albedo.x, ImGuiColorEditFlags_Float)) req.restart = true;
   if (ImGui::SliderFloat("g", &m.g, -0.99f, 0.99f)) req.restart = true;

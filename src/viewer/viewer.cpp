@@ -120,7 +120,7 @@ Viewer::Viewer(const ViewerOptions& o) : o_(o) {
   display_ = std::make_unique<DisplayPass>(*ctx_, *compiler_);
   readback_ = std::make_unique<ImageReadback>(*ctx_);
   displayTimer_ = std::make_unique<gpu::GpuTimer>(*ctx_, 4);
-  volumes_ = std::make_unique<VolumeCache>(*ctx_, s_.scene.media.at(0), BakeOptions{});
+  volumes_ = std::make_unique<VolumeCache>(*ctx_, s_.scene.medium(), BakeOptions{});
   renderer_ = makeViewRenderer(*ctx_, *compiler_, s_.scene);
   orbit_.reset(sceneCamera_.poseAt(s_.frame));
   stats_.device = ctx_->deviceName();
@@ -240,7 +240,7 @@ void Viewer::renderAndPresent(bool capture) {
     stats_.passes.insert(stats_.passes.end(), t.begin(), t.end());
   }
   if (restart_) {
-    renderer_->setVolume(volumes_->volume(s_.frame, s_.scene.media.at(0).densityScale));
+    renderer_->setVolume(volumes_->volume(s_.frame, s_.scene.medium().densityScale));
     renderer_->beginFrame(s_.frame, continuous_);
     restart_ = false;
   }
