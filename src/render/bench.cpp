@@ -4,8 +4,9 @@
 #include "core/hash.h"
 #include "core/log.h"
 #include "core/stats.h"
-#include "media/vdb_loader.h"
-#include "render/path_tracer.h"
+#include "io/image.h"
+#include "render/estimator.h"
+#include "render/volume_source.h"
 #include "scene/render_key.h"
 
 #include <glm/glm.hpp>
@@ -92,21 +93,33 @@ Image loadOrBuildReference(gpu::Context& ctx, gpu::ShaderCompiler& compiler, con
   logInfo(strf("bench: building the reference %s (%d spp)", path.c_str(), refSpp));
   Scene rs = s;
   rs.render.seed = 987654321;
-  PathTracer pt(ctx, compiler, rs);
-  pt.setVolume(volume);
-  pt.beginFrame(frame);
-  for (int done = 0; done < refSpp; done += 32) pt.addSamples(std::min(32, refSpp - done));
-  Image ref = pt.readImage();
+  std::unique_ptr<Estimator> pt = makeEstimator(EstimatorKind::PathTracer, ctx, compiler, rs, {.batch = 32});
+  pt->setVolumes(volume, nullptr);
+  pt->renderFrame(frame, refSpp, {});
+  Image ref = pt->readImage();
   makeFolder(fs::path(path).parent_path());
   writeExr(path, ref);
   return ref;
 }
 
+// A ReSTIR variant as the render settings that select it (mode restir-biased for RS_MIS_BIASED).
+RenderSettings withRestir(RenderSettings rs, const RestirOptions& v) {
+  rs.mode = v.mis == shared::RS_MIS_BIASED ? "restir-biased" : "restir";
+  rs.restirMis = v.mis == shared::RS_MIS_GBH ? "gbh" : "pairwise";
+  rs.restirCandidates = v.candidates;
+  rs.restirNeighbours = v.neighbours;
+  rs.restirRadius = v.radius;
+  rs.restirRounds = v.rounds;
+  rs.restirHistoryCap = v.historyCap;
+  return rs;
+}
+
 struct Method {
   std::string name;
-  int ptSpp = 0;  // > 0: the path tracer with this many spp per frame
-  std::unique_ptr<Restir> restir;
-  std::unique_ptr<PathTracer> pt;
+  bool pathTracer = false;  // a point of the path tracer's curve
+  int spp = 1;              // per frame (ReSTIR: one iteration)
+  std::unique_ptr<Scene> scene;  // its settings; outlives the estimator
+  std::unique_ptr<Estimator> estimator;
   std::vector<double> ms, err;
   std::map<std::string, std::vector<double>> passMs;
 };
@@ -223,10 +236,8 @@ BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Sce
   // the estimators, not the animation. Frame numbers count from it.
   const int first = o.gridFrame >= 0 ? o.gridFrame : scene.render.frameFirst;
   const int last = first + o.warmup + o.frames - 1;
-  const Medium& medium = scene.medium();
-  LoadedGrid grid = loadFloatGrid(medium.vdbPath(first), medium.densityGrid);
-  BakedVolume bake = bakeVolume(grid);
-  GpuVolumeResources volume(ctx, bake, medium.densityScale);
+  VolumeSource volumes(ctx, scene.medium(), {});
+  const GpuVolumeResources& volume = volumes.load(first);
 
   for (const bool moving : {false, true}) {
     const std::string cam = moving ? "moving" : "static";
@@ -239,40 +250,28 @@ BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Sce
       result.referenceRelMse = std::max(result.referenceRelMse, referenceOwnRelMse(refs[f]));
     }
     std::vector<Method> methods;
+    auto add = [&](Method m, const RenderSettings& rs, int batch) {
+      m.scene = std::make_unique<Scene>(s);
+      m.scene->render = rs;
+      m.estimator = makeEstimator(estimatorKind(rs), ctx, compiler, *m.scene, {.batch = batch});
+      m.estimator->setVolumes(volume, nullptr);  // the grid held still
+      methods.push_back(std::move(m));
+    };
     for (int spp : o.ptSpp) {
-      Method m;
-      m.name = strf("pt %d spp", spp);
-      m.ptSpp = spp;
-      m.pt = std::make_unique<PathTracer>(ctx, compiler, s);
-      m.pt->setVolume(volume);
-      methods.push_back(std::move(m));
+      RenderSettings rs = s.render;
+      rs.mode = "pt";
+      add({.name = strf("pt %d spp", spp), .pathTracer = true, .spp = spp}, rs, spp);  // one dispatch per frame
     }
-    for (const auto& [name, v] : variants) {
-      Method m;
-      m.name = name;
-      m.restir = std::make_unique<Restir>(ctx, compiler, s, v);
-      m.restir->setVolumes(volume, volume);
-      methods.push_back(std::move(m));
-    }
+    for (const auto& [name, v] : variants) add({.name = name}, withRestir(s.render, v), 1);
     // Alternating: every method renders frame f before any renders f + 1.
     for (int f = first; f <= last; ++f) {
       for (Method& m : methods) {
-        Image im;
-        double ms = 0;
-        PassTimes times;
         const bool warmup = f < first + o.warmup;  // rendered, not read back
-        if (m.pt) {
-          m.pt->beginFrame(f);
-          m.pt->addSamples(m.ptSpp);
-          if (!warmup) im = m.pt->readImage();
-          times = m.pt->lastPassTimes();
-        } else {
-          m.restir->render(f, 0, 0, false);
-          if (!warmup) im = m.restir->readImage();
-          times = m.restir->lastPassTimes();
-        }
+        m.estimator->renderFrame(f, m.spp, {});
         if (warmup) continue;
-        for (const auto& [n, t] : times) ms += t, m.passMs[n].push_back(t);
+        const Image im = m.estimator->readImage();
+        double ms = 0;
+        for (const auto& [n, t] : m.estimator->lastPassTimes()) ms += t, m.passMs[n].push_back(t);
         const Image& ref = moving ? refs.at(f) : refs.begin()->second;
         m.ms.push_back(ms);
         m.err.push_back(relMse(im, ref));
@@ -286,7 +285,7 @@ BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Sce
     }
     std::vector<std::pair<double, double>> curve;
     for (const Method& m : methods)
-      if (m.pt) curve.emplace_back(median(m.ms), median(m.err));
+      if (m.pathTracer) curve.emplace_back(median(m.ms), median(m.err));
     std::sort(curve.begin(), curve.end());
     for (const Method& m : methods) {
       BenchRow row;
@@ -294,7 +293,7 @@ BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Sce
       row.method = m.name;
       row.frameMs = median(m.ms);
       row.relMse = median(m.err);
-      if (!m.pt) {
+      if (!m.pathTracer) {
         row.ptRelMseAtEqualTime = ptCurveAt(curve, row.frameMs);
         row.gain = row.relMse > 0 ? row.ptRelMseAtEqualTime / row.relMse : 0;
       }

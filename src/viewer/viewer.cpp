@@ -9,8 +9,9 @@
 #include "viewer/imgui_layer.h"
 #include "viewer/orbit_camera.h"
 #include "viewer/swapchain.h"
+#include "render/estimator.h"
+#include "render/volume_source.h"
 #include "viewer/ui.h"
-#include "viewer/view_renderer.h"
 #include "viewer/window.h"
 
 #include <GLFW/glfw3.h>
@@ -67,6 +68,7 @@ class Viewer {
  private:
   void handleInput();
   void applyRequests(const UiRequests& req);
+  void makeRenderer();
   void rebuildRenderer();
   void cameraMoved();
   void setFrame(int frame);
@@ -83,11 +85,12 @@ class Viewer {
   std::unique_ptr<DisplayPass> display_;
   std::unique_ptr<ImageReadback> readback_;
   std::unique_ptr<gpu::GpuTimer> displayTimer_;
-  std::unique_ptr<VolumeCache> volumes_;
-  std::unique_ptr<ViewRenderer> renderer_;
+  std::unique_ptr<VolumeSource> volumes_;
+  std::unique_ptr<Estimator> renderer_;
   OrbitCamera orbit_;
   ViewStats stats_;
   bool restart_ = true, continuous_ = false, haveImage_ = false, displayTimed_ = false;
+  int historyFrame_ = 0;  // the animation frame of the renderer's history
   glm::dvec2 lastCursor_{0.0};
   int screenshots_ = 0;
   PassTimes rendererTimes_;
@@ -120,11 +123,12 @@ Viewer::Viewer(const ViewerOptions& o) : o_(o) {
   display_ = std::make_unique<DisplayPass>(*ctx_, *compiler_);
   readback_ = std::make_unique<ImageReadback>(*ctx_);
   displayTimer_ = std::make_unique<gpu::GpuTimer>(*ctx_, 4);
-  volumes_ = std::make_unique<VolumeCache>(*ctx_, s_.scene.medium(), BakeOptions{});
-  renderer_ = makeViewRenderer(*ctx_, *compiler_, s_.scene);
+  VolumeSourceOptions volumeOptions;
+  volumeOptions.interactive = true;
+  volumes_ = std::make_unique<VolumeSource>(*ctx_, s_.scene.medium(), volumeOptions);
+  makeRenderer();
   orbit_.reset(sceneCamera_.poseAt(s_.frame));
   stats_.device = ctx_->deviceName();
-  stats_.renderer = renderer_->name();
   stats_.width = image.x;
   stats_.height = image.y;
   glfwGetCursorPos(window_->handle(), &lastCursor_.x, &lastCursor_.y);
@@ -192,17 +196,24 @@ void Viewer::handleInput() {
   applyRequests(req);
 }
 
+// The estimator of the working scene's mode (parsed here, once per change).
+void Viewer::makeRenderer() {
+  const EstimatorKind kind = estimatorKind(s_.scene.render);
+  renderer_ = makeEstimator(kind, *ctx_, *compiler_, s_.scene);
+  stats_.renderer = renderer_->name();
+  stats_.usesSetting = estimatorTraits(kind).usesSetting;
+}
+
 void Viewer::rebuildRenderer() {
   renderer_.reset();
   try {
-    renderer_ = makeViewRenderer(*ctx_, *compiler_, s_.scene);
+    makeRenderer();
     s_.status.clear();
   } catch (const InputError& e) {
     s_.status = e.what();
     s_.scene.render.mode = "pt";  // back to what always works
-    renderer_ = makeViewRenderer(*ctx_, *compiler_, s_.scene);
+    makeRenderer();
   }
-  stats_.renderer = renderer_->name();
   restart_ = true;
   continuous_ = false;
 }
@@ -240,8 +251,13 @@ void Viewer::renderAndPresent(bool capture) {
     stats_.passes.insert(stats_.passes.end(), t.begin(), t.end());
   }
   if (restart_) {
-    renderer_->setVolume(volumes_->volume(s_.frame, s_.scene.medium().densityScale));
-    renderer_->beginFrame(s_.frame, continuous_);
+    // Temporal reuse follows the camera while the animation frame stays; a new animation frame (or
+    // an edit that breaks continuity) starts a fresh history, as the viewer keeps only the current
+    // frame's volume on the device.
+    if (!continuous_ || s_.frame != historyFrame_) renderer_->forgetHistory();
+    historyFrame_ = s_.frame;
+    renderer_->setVolumes(volumes_->load(s_.frame), nullptr);
+    renderer_->beginFrame(s_.frame);
     restart_ = false;
   }
   if (renderer_->samplesSoFar() < s_.maxSamples) {
