@@ -48,9 +48,7 @@ int runReference(const ReferenceArgs& a) {
     opt.progress = !a.quiet;
     ref::ReferenceStats stats;
     Image image = ref::renderReference(scene, grid.grid, opt, &stats);
-    image.meta["scene"] = a.scene;
-    image.meta["replaced_values"] = std::to_string(grid.replacedValues);
-    image.meta["render_key"] = key.text();
+    setFrameJobMeta(image, a, key, grid.replacedValues);
     a.outputs.write(frame, image);
     logInfo(strf("frame %d: %s  %.2fs  %.0f samples/s", frame, a.outputs.exrPath(frame).c_str(), stats.seconds,
                  stats.samplesPerSecond()));

@@ -4,6 +4,7 @@
 #include "app/settings_cli.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/progress.h"
 #include "gpu/context.h"
 #include "gpu/shader_compiler.h"
 #include "media/bake.h"
@@ -84,19 +85,12 @@ int renderFrames(const RenderArgs& a, const Scene& scene, gpu::Context& ctx, Est
     }
     Image image = estimator.readImage();
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    image.meta["version"] = PLUME_VERSION;
-    image.meta["mode"] = rs.mode;
-    image.meta["spp"] = std::to_string(rs.spp);
-    image.meta["seed"] = std::to_string(rs.seed);
-    image.meta["frame"] = std::to_string(frame);
-    image.meta["max_bounces"] = std::to_string(rs.maxBounces);
-    image.meta["device"] = ctx.deviceName();
+    setCommonMeta(image, {.mode = rs.mode, .spp = rs.spp, .seed = rs.seed, .frame = frame,
+                          .maxBounces = rs.maxBounces, .device = ctx.deviceName()});
+    setFrameJobMeta(image, a, jobs[j].key, volumes.replacedValues());
     image.meta["texels"] = texelFormatName(texels);
     image.meta["wall_time_s"] = strf("%.3f", seconds);
     image.meta["tracking_truncated"] = std::to_string(truncated);
-    image.meta["replaced_values"] = std::to_string(volumes.replacedValues());
-    image.meta["scene"] = a.scene;
-    image.meta["render_key"] = jobs[j].key.text();
     estimator.describe(image.meta);
     a.outputs.write(frame, image);
     progress.frameDone(frame, a.outputs.exrPath(frame), seconds, estimator.detail());

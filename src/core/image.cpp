@@ -31,4 +31,14 @@ void Image::setVariance(int x, int y, glm::vec3 v) {
   var[i + 2] = v.z;
 }
 
+void setCommonMeta(Image& image, const CommonMeta& c) {
+  image.meta["version"] = PLUME_VERSION;
+  image.meta["mode"] = c.mode;
+  image.meta["spp"] = std::to_string(c.spp);
+  image.meta["seed"] = std::to_string(c.seed);
+  image.meta["frame"] = std::to_string(c.frame);
+  if (c.maxBounces) image.meta["max_bounces"] = std::to_string(*c.maxBounces);
+  image.meta["device"] = c.device;
+}
+
 }  // namespace plume

@@ -4,7 +4,9 @@
 
 #include <glm/vec3.hpp>
 
+#include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -27,5 +29,18 @@ struct Image {
   glm::vec3 variance(int x, int y) const;
   void setVariance(int x, int y, glm::vec3 v);
 };
+
+// The header entries every image plume renders carries (plume render, plume reference, plume
+// view's screenshots), so that a file says what made it.
+struct CommonMeta {
+  std::string mode;               // pt, restir, restir-biased, reference
+  int spp = 0;                    // samples (ReSTIR: iterations) per pixel
+  int64_t seed = 0;
+  int frame = 0;
+  std::optional<int> maxBounces;  // absent from the viewer's screenshots (settings edited live)
+  std::string device;
+};
+// Sets version, mode, spp, seed, frame, max_bounces (when given) and device in image.meta.
+void setCommonMeta(Image& image, const CommonMeta& common);
 
 }  // namespace plume

@@ -44,15 +44,11 @@ std::string screenshotPath(const ViewerOptions& o, int frame, int count) {
 }
 
 // EXR (linear, metadata) beside the PNG preview, as `plume render --png` writes them.
-void saveScreenshot(const std::string& png, Image image, const ViewState& s, const std::string& device,
+void saveScreenshot(const std::string& png, Image image, int spp, const ViewState& s, const std::string& device,
                     const CameraPose& pose) {
   const RenderSettings& rs = s.scene.render;
-  image.meta["version"] = PLUME_VERSION;
+  setCommonMeta(image, {.mode = rs.mode, .spp = spp, .seed = rs.seed, .frame = s.frame, .device = device});
   image.meta["source"] = "plume view";
-  image.meta["mode"] = rs.mode;
-  image.meta["seed"] = std::to_string(rs.seed);
-  image.meta["frame"] = std::to_string(s.frame);
-  image.meta["device"] = device;
   image.meta["camera"] = strf("position %g %g %g look_at %g %g %g fov_y %g", pose.position.x, pose.position.y,
                               pose.position.z, pose.lookAt.x, pose.lookAt.y, pose.lookAt.z, pose.fovY);
   const std::string exr = std::filesystem::path(png).replace_extension(".exr").string();
@@ -234,9 +230,8 @@ void Viewer::applyRequests(const UiRequests& req) {
   }
   if (req.screenshot && haveImage_) {
     const std::string path = screenshotPath(o_, s_.frame, ++screenshots_);
-    Image image = renderer_->readImage();
-    image.meta["spp"] = std::to_string(renderer_->samplesSoFar());
-    saveScreenshot(path, std::move(image), s_, ctx_->deviceName(), s_.scene.camera.poseAt(s_.frame));
+    saveScreenshot(path, renderer_->readImage(), renderer_->samplesSoFar(), s_, ctx_->deviceName(),
+                   s_.scene.camera.poseAt(s_.frame));
     s_.status = "saved " + path + " and .exr";
     logInfo(s_.status);
   }
@@ -312,9 +307,8 @@ int Viewer::run() {
                  stats_.frameMs, stats_.fps, stats_.width, stats_.height, swapchain_->extent().width,
                  swapchain_->extent().height, stats_.renderer.c_str()));
     if (!o_.screenshot.empty()) {
-      Image image = renderer_->readImage();
-      image.meta["spp"] = std::to_string(renderer_->samplesSoFar());
-      saveScreenshot(o_.screenshot, std::move(image), s_, ctx_->deviceName(), s_.scene.camera.poseAt(s_.frame));
+      saveScreenshot(o_.screenshot, renderer_->readImage(), renderer_->samplesSoFar(), s_, ctx_->deviceName(),
+                     s_.scene.camera.poseAt(s_.frame));
       logInfo("view: wrote " + o_.screenshot);
     }
     if (!o_.captureWindow.empty()) {
