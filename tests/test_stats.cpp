@@ -5,6 +5,8 @@
 // variance (shared/accumulate.h). Fixed seeds.
 #include "core/error.h"
 #include "core/stats.h"
+#include "io/failure_images.h"
+#include "io/image.h"
 #include "support/test_support.h"
 
 #include "shaders/shared/accumulate.h"

@@ -4,7 +4,7 @@
 #include "app/settings_cli.h"
 #include "core/error.h"
 #include "core/log.h"
-#include "render/bench.h"
+#include "bench/bench.h"
 
 #include <cstdio>
 #include <memory>

@@ -6,6 +6,7 @@
 #include "core/log.h"
 #include "io/image.h"
 #include "media/vdb_loader.h"
+#include "media/volume_frames.h"
 #include "reference/reference.h"
 #include "scene/scene.h"
 
@@ -33,7 +34,7 @@ int runReference(const ReferenceArgs& a) {
   const RenderSettings& rs = scene.render;
   a.outputs.check(rs);
   checkVolumeFrames(scene, rs.frameFirst, rs.frameLast);
-  const Medium& medium = scene.media.at(0);
+  const Medium& medium = scene.medium();
   for (int frame = rs.frameFirst; frame <= rs.frameLast; ++frame) {
     const RenderKey key = referenceRenderKey(scene, frame);
     if (a.outputs.skip(frame, key)) continue;
@@ -47,9 +48,7 @@ int runReference(const ReferenceArgs& a) {
     opt.progress = !a.quiet;
     ref::ReferenceStats stats;
     Image image = ref::renderReference(scene, grid.grid, opt, &stats);
-    image.meta["scene"] = a.scene;
-    image.meta["replaced_values"] = std::to_string(grid.replacedValues);
-    image.meta["render_key"] = key.text();
+    setFrameJobMeta(image, a, key, grid.replacedValues);
     a.outputs.write(frame, image);
     logInfo(strf("frame %d: %s  %.2fs  %.0f samples/s", frame, a.outputs.exrPath(frame).c_str(), stats.seconds,
                  stats.samplesPerSecond()));

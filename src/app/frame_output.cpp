@@ -31,36 +31,6 @@ std::string FrameOutputs::pngPath(int frame) const {
   return std::filesystem::path(exrPath(frame)).replace_extension(".png").string();
 }
 
-void checkVolumeFrames(const Scene& scene, int first, int last) {
-  namespace fs = std::filesystem;
-  for (size_t i = 0; i < scene.media.size(); ++i) {
-    const Medium& m = scene.media[i];
-    std::string firstProblem;
-    int missing = 0;
-    for (int frame = first; frame <= (m.animated() ? last : first); ++frame) {
-      const std::string path = m.vdbPath(frame);
-      std::error_code ec;
-      const fs::file_status st = fs::status(path, ec);
-      std::string problem;
-      if (st.type() == fs::file_type::not_found) {
-        problem = "file not found: " + path;
-      } else if (ec) {
-        problem = "cannot read " + path + ": " + ec.message();
-      } else if (!fs::is_regular_file(st)) {
-        problem = "not a regular file: " + path;
-      } else if (::access(path.c_str(), R_OK) != 0) {
-        problem = "cannot read " + path + ": " + std::strerror(errno);
-      }
-      if (problem.empty()) continue;
-      if (missing++ == 0) firstProblem = m.animated() ? strf("frame %d: ", frame) + problem : problem;
-    }
-    if (missing == 0) continue;
-    std::string more;
-    if (missing > 1) more = strf(" (%d of frames %d-%d cannot be read)", missing, first, last);
-    throw InputError(scene.path + strf(": media[%zu].vdb: ", i) + firstProblem + more);
-  }
-}
-
 bool FrameOutputs::skip(int frame, const RenderKey& key) const {
   const std::string path = exrPath(frame);
   if (!resume || !std::filesystem::exists(path)) return false;
@@ -122,78 +92,6 @@ void FrameOutputs::write(int frame, const Image& image) const {
   writeExr(exrPath(frame), image);
 }
 
-FrameProgress::FrameProgress(int framesToRender, int sppPerFrame, bool enabled)
-    : total_(std::max(0, framesToRender)), spp_(std::max(1, sppPerFrame)), enabled_(enabled),
-      tty_(isatty(STDERR_FILENO) != 0), start_(std::chrono::steady_clock::now()), frameStart_(start_), lastDraw_(start_) {}
-
-void FrameProgress::beginFrame(int frame) {
-  frame_ = frame;
-  samples_ = 0;
-  frameStart_ = std::chrono::steady_clock::now();
-  if (enabled_ && tty_) drawBar();
-}
-
-void FrameProgress::samplesDone(int n) {
-  samples_ += n;
-  const auto now = std::chrono::steady_clock::now();
-  if (!enabled_ || !tty_ || now - lastDraw_ < std::chrono::milliseconds(100)) return;
-  lastDraw_ = now;
-  drawBar();
-}
-
-double FrameProgress::etaSeconds() const {
-  // Remaining frames at the mean time per finished frame (the current frame's elapsed time
-  // stands in before one has finished), minus the current frame's part already done.
-  const double inFrame = std::chrono::duration<double>(std::chrono::steady_clock::now() - frameStart_).count();
-  const double frac = std::min(1.0, double(samples_) / double(spp_));
-  double perFrame = done_ > 0 ? sumSeconds_ / done_ : (frac > 0 ? inFrame / frac : 0.0);
-  return std::max(0.0, perFrame * (total_ - done_) - (done_ > 0 ? perFrame * frac : inFrame));
-}
-
-void FrameProgress::drawBar() {
-  const double frac = total_ > 0 ? std::min(1.0, (done_ + std::min(1.0, double(samples_) / spp_)) / total_) : 1.0;
-  const int width = 24;
-  std::string bar(size_t(frac * width), '#');
-  bar.resize(width, '-');
-  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-  std::string times = done_ > 0 ? strf("last %.2fs/frame, mean %.2fs", lastSeconds_, sumSeconds_ / done_) : "";
-  std::fprintf(stderr, "\r\033[Krender [%s] %d/%d frames  frame %d  %s  elapsed %.1fs  eta %.1fs", bar.c_str(), done_,
-               total_, frame_, times.c_str(), elapsed, etaSeconds());
-  std::fflush(stderr);
-}
-
-void FrameProgress::frameDone(int frame, const std::string& path, double seconds, const std::string& detail) {
-  endFrame(frame, path, seconds, detail);
-}
-
-void FrameProgress::frameWarmed(int frame, double seconds) {
-  ++warmed_;
-  endFrame(frame, "pre-roll (not written)", seconds, "");
-}
-
-void FrameProgress::endFrame(int frame, const std::string& what, double seconds, const std::string& detail) {
-  ++done_;
-  sumSeconds_ += seconds;
-  lastSeconds_ = seconds;
-  samples_ = 0;
-  frameStart_ = std::chrono::steady_clock::now();
-  if (!enabled_) return;
-  if (tty_) std::fprintf(stderr, "\r\033[K");  // the log line replaces the bar, which is redrawn below it
-  logInfo(strf("frame %d (%d/%d): %s  %.2fs  eta %.1fs%s", frame, done_, total_, what.c_str(), seconds, etaSeconds(),
-               detail.empty() ? "" : ("  (" + detail + ")").c_str()));
-  if (tty_ && done_ < total_) drawBar();
-}
-
-void FrameProgress::finish() {
-  if (!enabled_) return;
-  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-  if (tty_) std::fprintf(stderr, "\r\033[K");
-  const int written = done_ - warmed_;
-  logInfo(strf("rendered %d frame%s%s in %.1fs%s", written, written == 1 ? "" : "s",
-               warmed_ > 0 ? strf(" and %d pre-roll frame%s", warmed_, warmed_ == 1 ? "" : "s").c_str() : "", elapsed,
-               done_ > 0 ? strf(" (%.2fs/frame)", sumSeconds_ / done_).c_str() : ""));
-}
-
 void addFrameJobOptions(CLI::App& cmd, FrameJobArgs& a) {
   cmd.add_option("scene", a.scene, "scene JSON file")->required();
   cmd.add_option("-o,--output", a.outputs.pattern, "output EXR; {frame:04} is replaced by the frame")->required();
@@ -203,6 +101,12 @@ void addFrameJobOptions(CLI::App& cmd, FrameJobArgs& a) {
   cmd.add_option("--width", a.width, "override camera.width")->check(CLI::Range(1, 16384));
   cmd.add_option("--height", a.height, "override camera.height")->check(CLI::Range(1, 16384));
   addSettingOptions(cmd, a.overrides);
+}
+
+void setFrameJobMeta(Image& image, const FrameJobArgs& a, const RenderKey& key, uint64_t replacedValues) {
+  image.meta["scene"] = a.scene;
+  image.meta["replaced_values"] = std::to_string(replacedValues);
+  image.meta["render_key"] = key.text();
 }
 
 Scene loadJobScene(const FrameJobArgs& a) {

@@ -1,9 +1,9 @@
 // Output handling shared by `plume reference` and `plume render`: frame patterns, up-front
 // writability checks, resume (a frame is complete when its EXR reads back with the same
-// settings in its header), EXR + optional PNG written atomically; and the progress display of a
-// frame sequence (bar with per-frame time and ETA on a terminal, one log line per frame otherwise).
+// settings in its header), EXR + optional PNG written atomically (the progress display of a frame
+// sequence: core/progress.h).
 // Both commands compare a full render key (every setting the pixels depend on) and check up front
-// that the VDB file of every frame they are asked for is there.
+// that the VDB file of every frame they are asked for is there (media/volume_frames.h).
 #pragma once
 
 #include "app/settings_cli.h"
@@ -12,20 +12,11 @@
 #include "scene/scene.h"
 #include "scene/settings.h"
 
-#include <chrono>
 #include <cstdint>
-#include <functional>
 #include <string>
-#include <utility>
 #include <vector>
 
 namespace plume {
-
-// Throws InputError "<scene>: media[i].vdb: frame F: file not found: <path>" (or "not a regular
-// file", "cannot read") for the first frame in [first, last] whose VDB file of some medium cannot
-// be read, so that a sequence with a hole fails before hours of rendering rather than at the hole.
-// Frames --resume will skip are checked too: the range is what the job was asked for.
-void checkVolumeFrames(const Scene& scene, int first, int last);
 
 struct FrameOutputs {
   std::string pattern;  // -o value; {frame:04} replaced per frame
@@ -45,31 +36,6 @@ struct FrameOutputs {
   void write(int frame, const Image& image) const;
 };
 
-// Progress over the frames a run renders (skipped ones are counted out up front; pre-roll frames,
-// rendered but not written, are counted in): on a terminal a bar redrawn as samples complete with
-// the last frame's time, the mean and the ETA; otherwise (logs, farm jobs) one plain line per
-// finished frame with the same numbers.
-class FrameProgress {
- public:
-  FrameProgress(int framesToRender, int sppPerFrame, bool enabled);
-  void beginFrame(int frame);
-  void samplesDone(int n);
-  void frameDone(int frame, const std::string& path, double seconds, const std::string& detail);
-  void frameWarmed(int frame, double seconds);  // a pre-roll frame
-  void finish();
-
- private:
-  void drawBar();
-  double etaSeconds() const;
-  void endFrame(int frame, const std::string& what, double seconds, const std::string& detail);
-
-  int total_, spp_;
-  bool enabled_, tty_;
-  int done_ = 0, warmed_ = 0, frame_ = 0, samples_ = 0;
-  double sumSeconds_ = 0, lastSeconds_ = 0;
-  std::chrono::steady_clock::time_point start_, frameStart_, lastDraw_;
-};
-
 // What every frame-producing command takes: the scene, -o/--png/--resume, -q, --width/--height
 // and every render.* setting as a flag.
 struct FrameJobArgs {
@@ -81,6 +47,9 @@ struct FrameJobArgs {
 };
 
 void addFrameJobOptions(CLI::App& cmd, FrameJobArgs& args);
+// The header entries of a frame job's image besides core/image.h's common ones: the scene as
+// given, the values the grid's sanitising replaced, and the render key that --resume compares.
+void setFrameJobMeta(Image& image, const FrameJobArgs& args, const RenderKey& key, uint64_t replacedValues);
 // Loads the scene with the command line's overrides applied; sets the log's quietness.
 Scene loadJobScene(const FrameJobArgs& args);
 

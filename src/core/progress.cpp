@@ -1,5 +1,8 @@
 #include "core/progress.h"
 
+#include "core/log.h"
+
+#include <algorithm>
 #include <cstdio>
 #include <unistd.h>
 
@@ -57,6 +60,78 @@ void ProgressBar::draw(uint64_t done, bool final) {
     std::fprintf(stderr, "%s: %.0f%% (%.1fs)\n", label_.c_str(), 100 * frac, elapsed);
   }
   std::fflush(stderr);
+}
+
+FrameProgress::FrameProgress(int framesToRender, int sppPerFrame, bool enabled)
+    : total_(std::max(0, framesToRender)), spp_(std::max(1, sppPerFrame)), enabled_(enabled),
+      tty_(isatty(STDERR_FILENO) != 0), start_(std::chrono::steady_clock::now()), frameStart_(start_), lastDraw_(start_) {}
+
+void FrameProgress::beginFrame(int frame) {
+  frame_ = frame;
+  samples_ = 0;
+  frameStart_ = std::chrono::steady_clock::now();
+  if (enabled_ && tty_) drawBar();
+}
+
+void FrameProgress::samplesDone(int n) {
+  samples_ += n;
+  const auto now = std::chrono::steady_clock::now();
+  if (!enabled_ || !tty_ || now - lastDraw_ < std::chrono::milliseconds(100)) return;
+  lastDraw_ = now;
+  drawBar();
+}
+
+double FrameProgress::etaSeconds() const {
+  // Remaining frames at the mean time per finished frame (the current frame's elapsed time
+  // stands in before one has finished), minus the current frame's part already done.
+  const double inFrame = std::chrono::duration<double>(std::chrono::steady_clock::now() - frameStart_).count();
+  const double frac = std::min(1.0, double(samples_) / double(spp_));
+  double perFrame = done_ > 0 ? sumSeconds_ / done_ : (frac > 0 ? inFrame / frac : 0.0);
+  return std::max(0.0, perFrame * (total_ - done_) - (done_ > 0 ? perFrame * frac : inFrame));
+}
+
+void FrameProgress::drawBar() {
+  const double frac = total_ > 0 ? std::min(1.0, (done_ + std::min(1.0, double(samples_) / spp_)) / total_) : 1.0;
+  const int width = 24;
+  std::string bar(size_t(frac * width), '#');
+  bar.resize(width, '-');
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  std::string times = done_ > 0 ? strf("last %.2fs/frame, mean %.2fs", lastSeconds_, sumSeconds_ / done_) : "";
+  std::fprintf(stderr, "\r\033[Krender [%s] %d/%d frames  frame %d  %s  elapsed %.1fs  eta %.1fs", bar.c_str(), done_,
+               total_, frame_, times.c_str(), elapsed, etaSeconds());
+  std::fflush(stderr);
+}
+
+void FrameProgress::frameDone(int frame, const std::string& path, double seconds, const std::string& detail) {
+  endFrame(frame, path, seconds, detail);
+}
+
+void FrameProgress::frameWarmed(int frame, double seconds) {
+  ++warmed_;
+  endFrame(frame, "pre-roll (not written)", seconds, "");
+}
+
+void FrameProgress::endFrame(int frame, const std::string& what, double seconds, const std::string& detail) {
+  ++done_;
+  sumSeconds_ += seconds;
+  lastSeconds_ = seconds;
+  samples_ = 0;
+  frameStart_ = std::chrono::steady_clock::now();
+  if (!enabled_) return;
+  if (tty_) std::fprintf(stderr, "\r\033[K");  // the log line replaces the bar, which is redrawn below it
+  logInfo(strf("frame %d (%d/%d): %s  %.2fs  eta %.1fs%s", frame, done_, total_, what.c_str(), seconds, etaSeconds(),
+               detail.empty() ? "" : ("  (" + detail + ")").c_str()));
+  if (tty_ && done_ < total_) drawBar();
+}
+
+void FrameProgress::finish() {
+  if (!enabled_) return;
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  if (tty_) std::fprintf(stderr, "\r\033[K");
+  const int written = done_ - warmed_;
+  logInfo(strf("rendered %d frame%s%s in %.1fs%s", written, written == 1 ? "" : "s",
+               warmed_ > 0 ? strf(" and %d pre-roll frame%s", warmed_, warmed_ == 1 ? "" : "s").c_str() : "", elapsed,
+               done_ > 0 ? strf(" (%.2fs/frame)", sumSeconds_ / done_).c_str() : ""));
 }
 
 }  // namespace plume

@@ -1,4 +1,5 @@
-// Progress bar on a terminal (stderr is a tty), plain log lines every 10% otherwise.
+// Progress displays: a bar over work items (the CPU reference's tiles) on a terminal (stderr is a
+// tty), plain log lines every 10% otherwise; and the progress of a frame sequence (plume render).
 #pragma once
 
 #include <atomic>
@@ -32,6 +33,31 @@ class ProgressBar {
   bool tty_;
   bool finished_ = false;
   std::mutex mutex_;
+};
+
+// Progress over the frames a run renders (skipped ones are counted out up front; pre-roll frames,
+// rendered but not written, are counted in): on a terminal a bar redrawn as samples complete with
+// the last frame's time, the mean and the ETA; otherwise (logs, farm jobs) one plain line per
+// finished frame with the same numbers.
+class FrameProgress {
+ public:
+  FrameProgress(int framesToRender, int sppPerFrame, bool enabled);
+  void beginFrame(int frame);
+  void samplesDone(int n);
+  void frameDone(int frame, const std::string& path, double seconds, const std::string& detail);
+  void frameWarmed(int frame, double seconds);  // a pre-roll frame
+  void finish();
+
+ private:
+  void drawBar();
+  double etaSeconds() const;
+  void endFrame(int frame, const std::string& what, double seconds, const std::string& detail);
+
+  int total_, spp_;
+  bool enabled_, tty_;
+  int done_ = 0, warmed_ = 0, frame_ = 0, samples_ = 0;
+  double sumSeconds_ = 0, lastSeconds_ = 0;
+  std::chrono::steady_clock::time_point start_, frameStart_, lastDraw_;
 };
 
 }  // namespace plume

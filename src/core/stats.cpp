@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <numeric>
@@ -275,9 +276,7 @@ std::string ZTestResult::summary() const {
 }
 
 Image zScoreImage(const ZTestResult& result) {
-  Image image;  // fields set directly: Image's constructor lives in plume_io
-  image.width = result.width;
-  image.height = result.height;
+  Image image(result.width, result.height);
   image.rgb = result.z;
   image.meta["content"] = "z-scores";
   return image;

@@ -1,18 +1,13 @@
 // Statistics for tests and measurements (DESIGN §6, §7): Pearson chi-square goodness of fit,
 // normal p-values, relMSE, and per-pixel Z-tests between images with a Šidák correction.
-//
-// Dependency note: this lives in plume_core but works on plume::Image (io/image.h). stats.cpp
-// only uses Image's fields and inline members, so plume_core needs no link dependency on
-// plume_io; writeFailureImages (which calls writeExr) is inline here for the same reason and is
-// compiled into the caller, which links plume_io.
+// The failed test's images as EXR files: io/failure_images.h.
 #pragma once
 
-#include "io/image.h"
+#include "core/image.h"
 
 #include <glm/vec3.hpp>
 
 #include <cstddef>
-#include <filesystem>
 #include <span>
 #include <string>
 #include <vector>
@@ -108,19 +103,9 @@ ZTestResult zTestAgainst(const Image& a, glm::vec3 exact, double alpha = kZTestA
 // The z-scores as an image (R,G,B = z per channel) for viewing beside the inputs.
 Image zScoreImage(const ZTestResult& result);
 
-// Writes <dir>/<name>_a.exr, _b.exr, _z.exr and _summary.txt; returns the folder. For tests on
-// failure (dir: build/test-output/<test>, see tests/support). Inline: see the note at the top.
+// Writes <dir>/<name>_summary.txt (the result's summary); returns its path. For tests on failure
+// (dir: build/test-output/<test>, see tests/support).
 std::string writeFailureReport(const std::string& dir, const std::string& name,
                                const ZTestResult& result);
-inline std::string writeFailureImages(const std::string& dir, const std::string& name,
-                                      const Image& a, const Image& b, const ZTestResult& result) {
-  std::filesystem::create_directories(dir);
-  const std::string base = (std::filesystem::path(dir) / name).string();
-  writeExr(base + "_a.exr", a);
-  writeExr(base + "_b.exr", b);
-  writeExr(base + "_z.exr", zScoreImage(result));
-  writeFailureReport(dir, name, result);
-  return dir;
-}
 
 }  // namespace plume

@@ -10,6 +10,10 @@
 // with VK_KHR_swapchain enabled. The default stays headless and compute-only.
 #pragma once
 
+#ifdef PLUME_NO_GPU
+#error "the CPU reference never includes gpu/: it is independent of what it checks (CMakeLists.txt)"
+#endif
+
 #include <vulkan/vulkan.h>
 
 #include <atomic>

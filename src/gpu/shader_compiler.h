@@ -3,6 +3,10 @@
 // hash of the source with all its includes, the defines and the compiler settings.
 #pragma once
 
+#ifdef PLUME_NO_GPU
+#error "the CPU reference never includes gpu/: it is independent of what it checks (CMakeLists.txt)"
+#endif
+
 #include <cstdint>
 #include <string>
 #include <utility>

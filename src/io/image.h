@@ -1,33 +1,14 @@
-// Linear RGB float images with an optional per-pixel variance of the mean (DESIGN §2 Images).
-// EXR layout: channels R,G,B; variance as var.R, var.G, var.B; header string attributes from
-// `meta` (renderer version, mode, spp, seed, wall time...). Writes are atomic.
+// Image files (the image itself: core/image.h). EXR layout: channels R,G,B; variance as var.R,
+// var.G, var.B; header string attributes from `meta` (renderer version, mode, spp, seed, wall
+// time...). Writes are atomic.
 #pragma once
 
-#include <glm/vec3.hpp>
+#include "core/image.h"
 
-#include <map>
 #include <string>
 #include <vector>
 
 namespace plume {
-
-struct Image {
-  int width = 0;
-  int height = 0;
-  std::vector<float> rgb;  // 3 * width * height, row 0 at the top
-  std::vector<float> var;  // empty, or 3 * width * height: variance of the mean per channel
-  std::map<std::string, std::string> meta;
-
-  Image() = default;
-  Image(int w, int h, bool withVariance = false);
-
-  bool hasVariance() const { return !var.empty(); }
-  size_t pixelCount() const { return size_t(width) * size_t(height); }
-  glm::vec3 pixel(int x, int y) const;
-  void setPixel(int x, int y, glm::vec3 v);
-  glm::vec3 variance(int x, int y) const;
-  void setVariance(int x, int y, glm::vec3 v);
-};
 
 // Throws InputError naming the file on any failure; never leaves a partial file.
 void writeExr(const std::string& path, const Image& image);

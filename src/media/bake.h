@@ -10,6 +10,10 @@
 // No OpenVDB types here: this header is included by GPU upload code and by tests alike.
 #pragma once
 
+#ifdef PLUME_NO_BAKE
+#error "the CPU reference never uses the bake: it checks what the bake does (CMakeLists.txt)"
+#endif
+
 #include <glm/glm.hpp>
 
 #include <cstdint>

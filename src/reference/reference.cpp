@@ -195,7 +195,7 @@ void checkReferenceSupports(const Scene& scene) {
 Image renderReference(const Scene& scene, openvdb::FloatGrid::ConstPtr density,
                       const ReferenceOptions& options, ReferenceStats* statsOut) {
   checkReferenceSupports(scene);
-  const Medium& m = scene.media.at(0);
+  const Medium& m = scene.medium();
   const RenderSettings& rs = scene.render;
   const Camera& cam = scene.camera;
   ReferenceMedium medium(density, m.densityScale);
@@ -259,17 +259,12 @@ Image renderReference(const Scene& scene, openvdb::FloatGrid::ConstPtr density,
                  options.frame, (unsigned long long)stats.truncatedTracking,
                  (unsigned long long)ReferenceMedium::kMaxTrackingSteps));
   }
-  image.meta["version"] = PLUME_VERSION;
-  image.meta["mode"] = "reference";
-  image.meta["spp"] = std::to_string(rs.spp);
-  image.meta["seed"] = std::to_string(rs.seed);
-  image.meta["frame"] = std::to_string(options.frame);
-  image.meta["max_bounces"] = std::to_string(rs.maxBounces);
+  setCommonMeta(image, {.mode = "reference", .spp = rs.spp, .seed = rs.seed, .frame = options.frame,
+                        .maxBounces = rs.maxBounces, .device = "cpu-reference"});
   image.meta["wall_time_s"] = strf("%.3f", seconds);
   image.meta["samples_per_s"] = strf("%.0f", stats.samplesPerSecond());
   image.meta["tracking_truncated"] = std::to_string(stats.truncatedTracking);
   image.meta["tracking_steps"] = std::to_string(stats.trackingSteps);
-  image.meta["device"] = "cpu-reference";
   if (statsOut) *statsOut = stats;
   return image;
 }

@@ -6,7 +6,7 @@
 // thread count. Accumulates in double; returns the mean and the per-pixel variance of the mean.
 #pragma once
 
-#include "io/image.h"
+#include "core/image.h"
 #include "scene/scene.h"
 
 #include <openvdb/openvdb.h>

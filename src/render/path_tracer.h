@@ -6,6 +6,7 @@
 #include "gpu/pipeline.h"
 #include "gpu/shader_compiler.h"
 #include "io/image.h"
+#include "render/features.h"
 #include "render/gpu_volume.h"
 #include "scene/scene.h"
 
@@ -13,18 +14,6 @@
 #include <string>
 
 namespace plume {
-
-// What a scene needs compiled in (DESIGN §5): light types present, multiple bounces.
-// (Whether tracking skips empty space is a property of the volume: see PathTracer::setVolume.)
-struct FeatureSet {
-  bool sun = false, point = false, environment = false, multiBounce = false;
-  gpu::ShaderDefines defines() const;
-  std::string name() const;  // e.g. "sun+env+multi"
-};
-FeatureSet featuresOf(const Scene& scene);
-
-// Per-pass GPU times of the last batch, ms.
-using PassTimes = std::vector<std::pair<std::string, double>>;
 
 class PathTracer {
  public:

@@ -24,7 +24,6 @@ RestirOptions restirOptionsOf(const RenderSettings& rs) {
   o.rounds = rs.restirRounds;
   o.historyCap = rs.restirHistoryCap;
   o.mis = rs.restirMis == "gbh" ? shared::RS_MIS_GBH : shared::RS_MIS_PAIRWISE;
-  if (rs.mode == "restir-biased") o.mis = shared::RS_MIS_BIASED;
   return o;
 }
 

@@ -32,7 +32,8 @@ struct RestirOptions {
   uint32_t mis = shared::RS_MIS_PAIRWISE;
   std::string name() const;  // e.g. "restir pairwise M4 k3 r16 R1 c20" (r: radius in px)
 };
-// From the scene's render settings (mode restir-biased selects RS_MIS_BIASED).
+// From the scene's render settings (render.restir_mis; mode restir-biased's RS_MIS_BIASED is set
+// by its estimator, render/restir_estimator.cpp).
 RestirOptions restirOptionsOf(const RenderSettings& rs);
 
 class Restir {

@@ -1,5 +1,5 @@
 // A frame's render key: what its pixels depend on (used by plume render/reference --resume,
-// app/frame_output.h, and by the bench's reference cache, render/bench.cpp).
+// app/frame_output.h, and by the bench's reference cache, bench/bench.cpp).
 #pragma once
 
 #include "scene/scene.h"

@@ -88,6 +88,9 @@ struct Scene {
   RenderSettings render;
 
   bool hasEnvironment() const;
+  // The scene's medium: parseScene accepts exactly one (several are not supported yet).
+  const Medium& medium() const { return media.at(0); }
+  Medium& medium() { return media.at(0); }
 };
 
 // Reads and validates a scene file. Throws InputError.

@@ -2,7 +2,6 @@
 
 #include "core/log.h"
 #include "scene/settings.h"
-#include "viewer/view_renderer.h"
 
 #include <glm/glm.hpp>
 #include <imgui.h>
@@ -34,25 +33,25 @@ void drawTransport(ViewState& s, UiRequests& req) {
   }
 }
 
-void drawModes(ViewState& s, UiRequests& req) {
-  for (const ModeInfo& m : viewModes()) {
-    ImGui::BeginDisabled(!m.available);
-    if (ImGui::RadioButton(m.mode.c_str(), s.scene.render.mode == m.mode)) {
-      s.scene.render.mode = m.mode;
-      req.rebuildRenderer = true;
-    }
-    ImGui::EndDisabled();
-    if (!m.available && ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled)) ImGui::SetTooltip("%s", m.note.c_str());
-    ImGui::SameLine();
-  }
-  ImGui::NewLine();
-}
-
 const SettingDesc* findSetting(const std::string& key) {
   for (const SettingDesc& d : renderSettingsTable()) {
     if (key == d.key) return &d;
   }
   return nullptr;
+}
+
+// One radio button per render.mode of the settings table.
+void drawModes(ViewState& s, UiRequests& req) {
+  const SettingDesc* d = findSetting("mode");
+  if (!d) return;
+  for (const std::string& mode : d->choices) {
+    if (ImGui::RadioButton(mode.c_str(), s.scene.render.mode == mode)) {
+      s.scene.render.mode = mode;
+      req.rebuildRenderer = true;
+    }
+    ImGui::SameLine();
+  }
+  ImGui::NewLine();
 }
 
 int intSetting(const RenderSettings& rs, const SettingDesc& d) {
@@ -74,8 +73,6 @@ void drawReuseToggle(ViewState& s, UiRequests& req, const char* label, const cha
     req.rebuildRenderer = true;
   }
 }
-
-bool isRestirMode(const std::string& mode) { return mode.rfind("restir", 0) == 0; }
 
 // One render setting from the table: a slider or field for numbers, a combo for choices.
 void drawSetting(ViewState& s, UiRequests& req, const SettingDesc& d) {
@@ -110,8 +107,9 @@ void drawSetting(ViewState& s, UiRequests& req, const SettingDesc& d) {
 }
 
 // Every render setting from the table except mode (radio buttons) and spp (per-frame control).
-void drawSettingsTable(ViewState& s, UiRequests& req) {
-  const bool restirOn = isRestirMode(s.scene.render.mode);
+void drawSettingsTable(ViewState& s, UiRequests& req, const ViewStats& stats) {
+  auto used = [&](const std::string& key) { return !stats.usesSetting || stats.usesSetting(key); };
+  const bool restirOn = used("restir_history_cap");
   static int historyCap = 20, rounds = 1;
   ImGui::BeginDisabled(!restirOn);
   drawReuseToggle(s, req, "temporal reuse", "restir_history_cap", historyCap);
@@ -122,7 +120,7 @@ void drawSettingsTable(ViewState& s, UiRequests& req) {
   for (const SettingDesc& d : renderSettingsTable()) {
     const std::string key = d.key;
     if (key == "mode" || key == "spp") continue;
-    const bool disabled = key.rfind("restir_", 0) == 0 && !restirOn;
+    const bool disabled = !used(key);
     ImGui::BeginDisabled(disabled);
     drawSetting(s, req, d);
     ImGui::EndDisabled();
@@ -130,7 +128,7 @@ void drawSettingsTable(ViewState& s, UiRequests& req) {
 }
 
 void drawMedium(ViewState& s, UiRequests& req) {
-  Medium& m = s.scene.media.at(0);
+  Medium& m = s.scene.medium();
   if (ImGui::SliderFloat("density scale", &m.densityScale, 0.0f, 200.0f, "%.2f", ImGuiSliderFlags_Logarithmic)) req.restart = true;
   if (ImGui::ColorEdit3("albedo", &m.albedo.x, ImGuiColorEditFlags_Float)) req.restart = true;
   if (ImGui::SliderFloat("g", &m.g, -0.99f, 0.99f)) req.restart = true;
@@ -167,7 +165,7 @@ UiRequests drawUi(ViewState& s, const ViewStats& stats) {
   drawTransport(s, req);
   if (ImGui::CollapsingHeader("Estimator", ImGuiTreeNodeFlags_DefaultOpen)) {
     drawModes(s, req);
-    drawSettingsTable(s, req);
+    drawSettingsTable(s, req, stats);
     ImGui::SliderInt("spp per frame", &s.sppPerFrame, 1, 64);
     if (ImGui::InputInt("max spp", &s.maxSamples)) s.maxSamples = std::max(1, s.maxSamples);
   }

@@ -3,9 +3,10 @@
 // added there (e.g. ReSTIR's M, k, radius) gets a widget without an edit here.
 #pragma once
 
-#include "render/path_tracer.h"
+#include "render/features.h"
 #include "scene/scene.h"
 
+#include <functional>
 #include <string>
 
 namespace plume::viewer {
@@ -19,11 +20,12 @@ struct ViewState {
   float exposure = 0.0f;        // stops
   bool showUi = true;
   bool userCamera = false;      // the orbit camera overrides the scene's camera path
-  std::string status;           // last message (screenshot written, mode unavailable...)
+  std::string status;           // last message (screenshot written, renderer failed...)
 };
 
 struct ViewStats {
   std::string device, renderer;
+  std::function<bool(const std::string&)> usesSetting;  // the renderer's (render/estimator.h)
   double fps = 0, frameMs = 0;
   PassTimes passes;             // renderer passes of the last batch, then "display"
   int samples = 0;

@@ -9,8 +9,9 @@
 #include "viewer/imgui_layer.h"
 #include "viewer/orbit_camera.h"
 #include "viewer/swapchain.h"
+#include "render/estimator.h"
+#include "render/volume_source.h"
 #include "viewer/ui.h"
-#include "viewer/view_renderer.h"
 #include "viewer/window.h"
 
 #include <GLFW/glfw3.h>
@@ -43,15 +44,11 @@ std::string screenshotPath(const ViewerOptions& o, int frame, int count) {
 }
 
 // EXR (linear, metadata) beside the PNG preview, as `plume render --png` writes them.
-void saveScreenshot(const std::string& png, Image image, const ViewState& s, const std::string& device,
+void saveScreenshot(const std::string& png, Image image, int spp, const ViewState& s, const std::string& device,
                     const CameraPose& pose) {
   const RenderSettings& rs = s.scene.render;
-  image.meta["version"] = PLUME_VERSION;
+  setCommonMeta(image, {.mode = rs.mode, .spp = spp, .seed = rs.seed, .frame = s.frame, .device = device});
   image.meta["source"] = "plume view";
-  image.meta["mode"] = rs.mode;
-  image.meta["seed"] = std::to_string(rs.seed);
-  image.meta["frame"] = std::to_string(s.frame);
-  image.meta["device"] = device;
   image.meta["camera"] = strf("position %g %g %g look_at %g %g %g fov_y %g", pose.position.x, pose.position.y,
                               pose.position.z, pose.lookAt.x, pose.lookAt.y, pose.lookAt.z, pose.fovY);
   const std::string exr = std::filesystem::path(png).replace_extension(".exr").string();
@@ -67,6 +64,7 @@ class Viewer {
  private:
   void handleInput();
   void applyRequests(const UiRequests& req);
+  void makeRenderer();
   void rebuildRenderer();
   void cameraMoved();
   void setFrame(int frame);
@@ -83,11 +81,12 @@ class Viewer {
   std::unique_ptr<DisplayPass> display_;
   std::unique_ptr<ImageReadback> readback_;
   std::unique_ptr<gpu::GpuTimer> displayTimer_;
-  std::unique_ptr<VolumeCache> volumes_;
-  std::unique_ptr<ViewRenderer> renderer_;
+  std::unique_ptr<VolumeSource> volumes_;
+  std::unique_ptr<Estimator> renderer_;
   OrbitCamera orbit_;
   ViewStats stats_;
   bool restart_ = true, continuous_ = false, haveImage_ = false, displayTimed_ = false;
+  int historyFrame_ = 0;  // the animation frame of the renderer's history
   glm::dvec2 lastCursor_{0.0};
   int screenshots_ = 0;
   PassTimes rendererTimes_;
@@ -120,11 +119,12 @@ Viewer::Viewer(const ViewerOptions& o) : o_(o) {
   display_ = std::make_unique<DisplayPass>(*ctx_, *compiler_);
   readback_ = std::make_unique<ImageReadback>(*ctx_);
   displayTimer_ = std::make_unique<gpu::GpuTimer>(*ctx_, 4);
-  volumes_ = std::make_unique<VolumeCache>(*ctx_, s_.scene.media.at(0), BakeOptions{});
-  renderer_ = makeViewRenderer(*ctx_, *compiler_, s_.scene);
+  VolumeSourceOptions volumeOptions;
+  volumeOptions.interactive = true;
+  volumes_ = std::make_unique<VolumeSource>(*ctx_, s_.scene.medium(), volumeOptions);
+  makeRenderer();
   orbit_.reset(sceneCamera_.poseAt(s_.frame));
   stats_.device = ctx_->deviceName();
-  stats_.renderer = renderer_->name();
   stats_.width = image.x;
   stats_.height = image.y;
   glfwGetCursorPos(window_->handle(), &lastCursor_.x, &lastCursor_.y);
@@ -192,17 +192,24 @@ void Viewer::handleInput() {
   applyRequests(req);
 }
 
+// The estimator of the working scene's mode (parsed here, once per change).
+void Viewer::makeRenderer() {
+  const EstimatorKind kind = estimatorKind(s_.scene.render);
+  renderer_ = makeEstimator(kind, *ctx_, *compiler_, s_.scene);
+  stats_.renderer = renderer_->name();
+  stats_.usesSetting = estimatorTraits(kind).usesSetting;
+}
+
 void Viewer::rebuildRenderer() {
   renderer_.reset();
   try {
-    renderer_ = makeViewRenderer(*ctx_, *compiler_, s_.scene);
+    makeRenderer();
     s_.status.clear();
   } catch (const InputError& e) {
     s_.status = e.what();
     s_.scene.render.mode = "pt";  // back to what always works
-    renderer_ = makeViewRenderer(*ctx_, *compiler_, s_.scene);
+    makeRenderer();
   }
-  stats_.renderer = renderer_->name();
   restart_ = true;
   continuous_ = false;
 }
@@ -223,9 +230,8 @@ void Viewer::applyRequests(const UiRequests& req) {
   }
   if (req.screenshot && haveImage_) {
     const std::string path = screenshotPath(o_, s_.frame, ++screenshots_);
-    Image image = renderer_->readImage();
-    image.meta["spp"] = std::to_string(renderer_->samplesSoFar());
-    saveScreenshot(path, std::move(image), s_, ctx_->deviceName(), s_.scene.camera.poseAt(s_.frame));
+    saveScreenshot(path, renderer_->readImage(), renderer_->samplesSoFar(), s_, ctx_->deviceName(),
+                   s_.scene.camera.poseAt(s_.frame));
     s_.status = "saved " + path + " and .exr";
     logInfo(s_.status);
   }
@@ -240,8 +246,13 @@ void Viewer::renderAndPresent(bool capture) {
     stats_.passes.insert(stats_.passes.end(), t.begin(), t.end());
   }
   if (restart_) {
-    renderer_->setVolume(volumes_->volume(s_.frame, s_.scene.media.at(0).densityScale));
-    renderer_->beginFrame(s_.frame, continuous_);
+    // Temporal reuse follows the camera while the animation frame stays; a new animation frame (or
+    // an edit that breaks continuity) starts a fresh history, as the viewer keeps only the current
+    // frame's volume on the device.
+    if (!continuous_ || s_.frame != historyFrame_) renderer_->forgetHistory();
+    historyFrame_ = s_.frame;
+    renderer_->setVolumes(volumes_->load(s_.frame), nullptr);
+    renderer_->beginFrame(s_.frame);
     restart_ = false;
   }
   if (renderer_->samplesSoFar() < s_.maxSamples) {
@@ -296,9 +307,8 @@ int Viewer::run() {
                  stats_.frameMs, stats_.fps, stats_.width, stats_.height, swapchain_->extent().width,
                  swapchain_->extent().height, stats_.renderer.c_str()));
     if (!o_.screenshot.empty()) {
-      Image image = renderer_->readImage();
-      image.meta["spp"] = std::to_string(renderer_->samplesSoFar());
-      saveScreenshot(o_.screenshot, std::move(image), s_, ctx_->deviceName(), s_.scene.camera.poseAt(s_.frame));
+      saveScreenshot(o_.screenshot, renderer_->readImage(), renderer_->samplesSoFar(), s_, ctx_->deviceName(),
+                     s_.scene.camera.poseAt(s_.frame));
       logInfo("view: wrote " + o_.screenshot);
     }
     if (!o_.captureWindow.empty()) {

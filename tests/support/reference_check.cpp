@@ -1,6 +1,7 @@
 #include "support/reference_check.h"
 
 #include "core/log.h"
+#include "io/failure_images.h"
 #include "support/test_support.h"
 
 #include <gtest/gtest.h>

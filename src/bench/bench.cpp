@@ -1,11 +1,14 @@
-#include "render/bench.h"
+#include "bench/bench.h"
+
+#include "bench/report.h"
 
 #include "core/error.h"
 #include "core/hash.h"
 #include "core/log.h"
 #include "core/stats.h"
-#include "media/vdb_loader.h"
-#include "render/path_tracer.h"
+#include "io/image.h"
+#include "render/estimator.h"
+#include "render/volume_source.h"
 #include "scene/render_key.h"
 
 #include <glm/glm.hpp>
@@ -13,7 +16,6 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <memory>
 
@@ -71,7 +73,7 @@ uint64_t referenceKey(const Scene& s, int gridFrame) {
     return k != "mode" && k != "spp" && k != "seed" && k.rfind("restir_", 0) != 0;
   });
   std::error_code ec;
-  const fs::path vdb = s.media.at(0).vdbPath(gridFrame);
+  const fs::path vdb = s.medium().vdbPath(gridFrame);
   const auto size = fs::file_size(vdb, ec);
   const auto time = fs::last_write_time(vdb, ec).time_since_epoch().count();
   return fnv1a(render.text() + strf("|%llu|%lld", (unsigned long long)size, (long long)time));
@@ -92,21 +94,33 @@ Image loadOrBuildReference(gpu::Context& ctx, gpu::ShaderCompiler& compiler, con
   logInfo(strf("bench: building the reference %s (%d spp)", path.c_str(), refSpp));
   Scene rs = s;
   rs.render.seed = 987654321;
-  PathTracer pt(ctx, compiler, rs);
-  pt.setVolume(volume);
-  pt.beginFrame(frame);
-  for (int done = 0; done < refSpp; done += 32) pt.addSamples(std::min(32, refSpp - done));
-  Image ref = pt.readImage();
+  std::unique_ptr<Estimator> pt = makeEstimator(EstimatorKind::PathTracer, ctx, compiler, rs, {.batch = 32});
+  pt->setVolumes(volume, nullptr);
+  pt->renderFrame(frame, refSpp, {});
+  Image ref = pt->readImage();
   makeFolder(fs::path(path).parent_path());
   writeExr(path, ref);
   return ref;
 }
 
+// A ReSTIR variant as the render settings that select it (mode restir-biased for RS_MIS_BIASED).
+RenderSettings withRestir(RenderSettings rs, const RestirOptions& v) {
+  rs.mode = v.mis == shared::RS_MIS_BIASED ? "restir-biased" : "restir";
+  rs.restirMis = v.mis == shared::RS_MIS_GBH ? "gbh" : "pairwise";
+  rs.restirCandidates = v.candidates;
+  rs.restirNeighbours = v.neighbours;
+  rs.restirRadius = v.radius;
+  rs.restirRounds = v.rounds;
+  rs.restirHistoryCap = v.historyCap;
+  return rs;
+}
+
 struct Method {
   std::string name;
-  int ptSpp = 0;  // > 0: the path tracer with this many spp per frame
-  std::unique_ptr<Restir> restir;
-  std::unique_ptr<PathTracer> pt;
+  bool pathTracer = false;  // a point of the path tracer's curve
+  int spp = 1;              // per frame (ReSTIR: one iteration)
+  std::unique_ptr<Scene> scene;  // its settings; outlives the estimator
+  std::unique_ptr<Estimator> estimator;
   std::vector<double> ms, err;
   std::map<std::string, std::vector<double>> passMs;
 };
@@ -121,64 +135,6 @@ double ptCurveAt(const std::vector<std::pair<double, double>>& pts, double ms) {
   const double y0 = std::log(pts[i].second), y1 = std::log(pts[i + 1].second);
   const double t = (std::log(ms) - x0) / (x1 - x0);
   return std::exp(y0 + t * (y1 - y0));
-}
-
-std::string svgPlot(const std::vector<BenchRow>& rows, const std::string& title) {
-  double xmin = 1e30, xmax = 0, ymin = 1e30, ymax = 0;
-  for (const auto& r : rows) {
-    if (!(r.frameMs > 0 && r.relMse > 0)) continue;
-    xmin = std::min(xmin, r.frameMs), xmax = std::max(xmax, r.frameMs);
-    ymin = std::min(ymin, r.relMse), ymax = std::max(ymax, r.relMse);
-  }
-  if (xmax <= 0) return "<svg xmlns='http://www.w3.org/2000/svg'/>";
-  const double W = 760, H = 480, L = 80, R = 230, T = 40, B = 60;
-  auto X = [&](double v) { return L + (std::log10(v) - std::log10(xmin / 1.2)) / (std::log10(xmax * 1.2) - std::log10(xmin / 1.2)) * (W - L - R); };
-  auto Y = [&](double v) { return H - B - (std::log10(v) - std::log10(ymin / 1.5)) / (std::log10(ymax * 1.5) - std::log10(ymin / 1.5)) * (H - T - B); };
-  std::string s = strf("<svg xmlns='http://www.w3.org/2000/svg' width='%.0f' height='%.0f' font-family='sans-serif' font-size='11'>\n", W, H);
-  s += strf("<rect width='100%%' height='100%%' fill='white'/><text x='%.0f' y='22' font-size='14'>%s</text>\n", L, title.c_str());
-  s += strf("<line x1='%.0f' y1='%.0f' x2='%.0f' y2='%.0f' stroke='black'/>", L, H - B, W - R, H - B);
-  s += strf("<line x1='%.0f' y1='%.0f' x2='%.0f' y2='%.0f' stroke='black'/>\n", L, T, L, H - B);
-  s += strf("<text x='%.0f' y='%.0f'>GPU time per frame (ms, log)</text>", L + 150, H - 20);
-  s += strf("<text x='12' y='%.0f' transform='rotate(-90 12 %.0f)'>relMSE (log)</text>\n", H / 2 + 40, H / 2 + 40);
-  for (int e = int(std::floor(std::log10(ymin / 1.5))); e <= int(std::ceil(std::log10(ymax * 1.5))); ++e) {
-    const double v = std::pow(10.0, e);
-    if (v < ymin / 1.5 || v > ymax * 1.5) continue;
-    s += strf("<text x='%.0f' y='%.0f' text-anchor='end'>1e%d</text>", L - 4, Y(v) + 4, e);
-  }
-  for (int e = int(std::floor(std::log10(xmin / 1.2))); e <= int(std::ceil(std::log10(xmax * 1.2))); ++e) {
-    for (double m : {1.0, 2.0, 5.0}) {
-      const double v = m * std::pow(10.0, e);
-      if (v < xmin / 1.2 || v > xmax * 1.2) continue;
-      s += strf("<text x='%.0f' y='%.0f' text-anchor='middle'>%g</text>", X(v), H - B + 14, v);
-    }
-  }
-  const char* colours[] = {"#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf", "#8c564b", "#e377c2", "#bcbd22"};
-  for (const char* cam : {"static", "moving"}) {
-    std::string line;
-    for (const auto& r : rows)
-      if (r.camera == cam && r.method.rfind("pt ", 0) == 0) line += strf("%.1f,%.1f ", X(r.frameMs), Y(r.relMse));
-    if (!line.empty())
-      s += strf("<polyline points='%s' fill='none' stroke='black' %s/>\n", line.c_str(),
-                std::string(cam) == "moving" ? "stroke-dasharray='4 3'" : "");
-  }
-  int legend = 0;
-  std::map<std::string, int> colourOf;
-  for (const auto& r : rows) {
-    const bool pt = r.method.rfind("pt ", 0) == 0;
-    const std::string key = pt ? "path tracer" : r.method;
-    if (!colourOf.count(key)) colourOf[key] = int(colourOf.size());
-    const char* c = pt ? "black" : colours[colourOf[key] % 8];
-    if (r.camera == "static") s += strf("<circle cx='%.1f' cy='%.1f' r='4' fill='%s'/>", X(r.frameMs), Y(r.relMse), c);
-    else s += strf("<rect x='%.1f' y='%.1f' width='7' height='7' fill='none' stroke='%s'/>", X(r.frameMs) - 3.5, Y(r.relMse) - 3.5, c);
-  }
-  for (const auto& [key, i] : colourOf) {
-    const char* c = key == "path tracer" ? "black" : colours[i % 8];
-    s += strf("<circle cx='%.0f' cy='%.0f' r='4' fill='%s'/><text x='%.0f' y='%.0f'>%s</text>\n", W - R + 15, T + 16.0 * legend, c,
-              W - R + 24, T + 16.0 * legend + 4, key.c_str());
-    ++legend;
-  }
-  s += strf("<text x='%.0f' y='%.0f'>filled: static camera; open squares, dashed: moving</text>\n", W - R + 10, T + 16.0 * legend + 10);
-  return s + "</svg>\n";
 }
 
 }  // namespace
@@ -223,10 +179,8 @@ BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Sce
   // the estimators, not the animation. Frame numbers count from it.
   const int first = o.gridFrame >= 0 ? o.gridFrame : scene.render.frameFirst;
   const int last = first + o.warmup + o.frames - 1;
-  const Medium& medium = scene.media.at(0);
-  LoadedGrid grid = loadFloatGrid(medium.vdbPath(first), medium.densityGrid);
-  BakedVolume bake = bakeVolume(grid);
-  GpuVolumeResources volume(ctx, bake, medium.densityScale);
+  VolumeSource volumes(ctx, scene.medium(), {});
+  const GpuVolumeResources& volume = volumes.load(first);
 
   for (const bool moving : {false, true}) {
     const std::string cam = moving ? "moving" : "static";
@@ -239,40 +193,28 @@ BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Sce
       result.referenceRelMse = std::max(result.referenceRelMse, referenceOwnRelMse(refs[f]));
     }
     std::vector<Method> methods;
+    auto add = [&](Method m, const RenderSettings& rs, int batch) {
+      m.scene = std::make_unique<Scene>(s);
+      m.scene->render = rs;
+      m.estimator = makeEstimator(estimatorKind(rs), ctx, compiler, *m.scene, {.batch = batch});
+      m.estimator->setVolumes(volume, nullptr);  // the grid held still
+      methods.push_back(std::move(m));
+    };
     for (int spp : o.ptSpp) {
-      Method m;
-      m.name = strf("pt %d spp", spp);
-      m.ptSpp = spp;
-      m.pt = std::make_unique<PathTracer>(ctx, compiler, s);
-      m.pt->setVolume(volume);
-      methods.push_back(std::move(m));
+      RenderSettings rs = s.render;
+      rs.mode = "pt";
+      add({.name = strf("pt %d spp", spp), .pathTracer = true, .spp = spp}, rs, spp);  // one dispatch per frame
     }
-    for (const auto& [name, v] : variants) {
-      Method m;
-      m.name = name;
-      m.restir = std::make_unique<Restir>(ctx, compiler, s, v);
-      m.restir->setVolumes(volume, volume);
-      methods.push_back(std::move(m));
-    }
+    for (const auto& [name, v] : variants) add({.name = name}, withRestir(s.render, v), 1);
     // Alternating: every method renders frame f before any renders f + 1.
     for (int f = first; f <= last; ++f) {
       for (Method& m : methods) {
-        Image im;
-        double ms = 0;
-        PassTimes times;
         const bool warmup = f < first + o.warmup;  // rendered, not read back
-        if (m.pt) {
-          m.pt->beginFrame(f);
-          m.pt->addSamples(m.ptSpp);
-          if (!warmup) im = m.pt->readImage();
-          times = m.pt->lastPassTimes();
-        } else {
-          m.restir->render(f, 0, 0, false);
-          if (!warmup) im = m.restir->readImage();
-          times = m.restir->lastPassTimes();
-        }
+        m.estimator->renderFrame(f, m.spp, {});
         if (warmup) continue;
-        for (const auto& [n, t] : times) ms += t, m.passMs[n].push_back(t);
+        const Image im = m.estimator->readImage();
+        double ms = 0;
+        for (const auto& [n, t] : m.estimator->lastPassTimes()) ms += t, m.passMs[n].push_back(t);
         const Image& ref = moving ? refs.at(f) : refs.begin()->second;
         m.ms.push_back(ms);
         m.err.push_back(relMse(im, ref));
@@ -286,7 +228,7 @@ BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Sce
     }
     std::vector<std::pair<double, double>> curve;
     for (const Method& m : methods)
-      if (m.pt) curve.emplace_back(median(m.ms), median(m.err));
+      if (m.pathTracer) curve.emplace_back(median(m.ms), median(m.err));
     std::sort(curve.begin(), curve.end());
     for (const Method& m : methods) {
       BenchRow row;
@@ -294,7 +236,7 @@ BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Sce
       row.method = m.name;
       row.frameMs = median(m.ms);
       row.relMse = median(m.err);
-      if (!m.pt) {
+      if (!m.pathTracer) {
         row.ptRelMseAtEqualTime = ptCurveAt(curve, row.frameMs);
         row.gain = row.relMse > 0 ? row.ptRelMseAtEqualTime / row.relMse : 0;
       }
@@ -303,30 +245,7 @@ BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Sce
     }
   }
 
-  // Outputs.
-  std::string md = strf("Device: %s. Scene: %s, %dx%d, max_bounces %d, the grid of frame %d held still. Warm-up %d "
-                        "frames, %d measured; medians. Reference: GPU path tracer, %d spp (own relMSE <= %.2g).\n\n",
-                        result.device.c_str(), scene.path.c_str(), scene.camera.width, scene.camera.height,
-                        scene.render.maxBounces, first, o.warmup, o.frames, o.refSpp, result.referenceRelMse);
-  md += "| camera | method | GPU ms/frame | relMSE | PT relMSE at equal time | gain vs PT | per-pass ms |\n";
-  md += "|---|---|---|---|---|---|---|\n";
-  std::string csv = "camera,method,frame_ms,relmse,pt_relmse_equal_time,gain\n";
-  for (const BenchRow& r : result.rows) {
-    const bool pt = r.method.rfind("pt ", 0) == 0;
-    md += strf("| %s | %s | %.1f | %.4g | %s | %s | %s |\n", r.camera.c_str(), r.method.c_str(), r.frameMs, r.relMse,
-               pt ? "" : strf("%.4g", r.ptRelMseAtEqualTime).c_str(), pt ? "" : strf("%.2fx", r.gain).c_str(),
-               r.passTimes.c_str());
-    csv += strf("%s,%s,%.4f,%.6g,%.6g,%.4f\n", r.camera.c_str(), r.method.c_str(), r.frameMs, r.relMse,
-                r.ptRelMseAtEqualTime, r.gain);
-  }
-  result.markdown = md;
-  const std::string stem = fs::path(scene.path).stem().string();
-  result.mdPath = (fs::path(dir) / (stem + "_bench.md")).string();
-  result.csvPath = (fs::path(dir) / (stem + "_bench.csv")).string();
-  result.svgPath = (fs::path(dir) / (stem + "_bench.svg")).string();
-  std::ofstream(result.mdPath) << md;
-  std::ofstream(result.csvPath) << csv;
-  std::ofstream(result.svgPath) << svgPlot(result.rows, "relMSE against GPU time per frame: " + stem + " (" + result.device + ")");
+  writeBenchReport(result, scene, o, first, dir);
   return result;
 }
 

@@ -1,0 +1,27 @@
+// What the GPU estimators share about a scene and a pass: the feature set their shaders are
+// compiled for (DESIGN §5) and the per-pass GPU times they report.
+#pragma once
+
+#include "gpu/shader_compiler.h"
+#include "scene/scene.h"
+
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace plume {
+
+// What a scene needs compiled in (DESIGN §5): light types present, multiple bounces.
+// (Whether tracking skips empty space is a property of the volume: see PathTracer::setVolume.)
+// Defined in render/path_tracer.cpp.
+struct FeatureSet {
+  bool sun = false, point = false, environment = false, multiBounce = false;
+  gpu::ShaderDefines defines() const;
+  std::string name() const;  // e.g. "sun+env+multi"
+};
+FeatureSet featuresOf(const Scene& scene);
+
+// Per-pass GPU times of the last batch, ms.
+using PassTimes = std::vector<std::pair<std::string, double>>;
+
+}  // namespace plume
