@@ -13,7 +13,6 @@ namespace plume {
 
 // What a scene needs compiled in (DESIGN §5): light types present, multiple bounces.
 // (Whether tracking skips empty space is a property of the volume: see PathTracer::setVolume.)
-// Defined in render/path_tracer.cpp.
 struct FeatureSet {
   bool sun = false, point = false, environment = false, multiBounce = false;
   gpu::ShaderDefines defines() const;

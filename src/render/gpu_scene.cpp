@@ -76,7 +76,7 @@ bool sameCamera(const shared::GpuCamera& a, const shared::GpuCamera& b) {
 
 shared::GpuFrame gpuFrame(const Scene& scene, int frame, uint32_t seed, uint32_t frameKey, uint32_t sppPerDispatch) {
   const Camera& cam = scene.camera;
-  const Medium& m = scene.media.at(0);
+  const Medium& m = scene.medium();
   const RenderSettings& rs = scene.render;
   shared::GpuFrame f{};
   f.camera = gpuCamera(cam, frame);

@@ -35,7 +35,7 @@ Image renderGpuPt(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene&
   BakeOptions options;
   options.format = format;
   BakedVolume bake = bakeVolume(loaded, options);
-  GpuVolumeResources volume(ctx, bake, scene.media.at(0).densityScale);
+  GpuVolumeResources volume(ctx, bake, scene.medium().densityScale);
   PathTracer tracer(ctx, compiler, scene);
   tracer.setVolume(volume);
   tracer.beginFrame(frame);

@@ -1,0 +1,39 @@
+#include "render/features.h"
+
+namespace plume {
+
+gpu::ShaderDefines FeatureSet::defines() const {
+  gpu::ShaderDefines d;
+  if (sun) d.emplace_back("PLUME_HAS_SUN", "1");
+  if (point) d.emplace_back("PLUME_HAS_POINT", "1");
+  if (environment) d.emplace_back("PLUME_HAS_ENV", "1");
+  if (multiBounce) d.emplace_back("PLUME_MULTI_BOUNCE", "1");
+  return d;
+}
+
+std::string FeatureSet::name() const {
+  std::string n;
+  auto add = [&](bool on, const char* s) {
+    if (!on) return;
+    if (!n.empty()) n += '+';
+    n += s;
+  };
+  add(sun, "sun");
+  add(point, "point");
+  add(environment, "env");
+  add(multiBounce, "multi");
+  return n.empty() ? "none" : n;
+}
+
+FeatureSet featuresOf(const Scene& scene) {
+  FeatureSet f;
+  for (const Light& l : scene.lights) {
+    f.sun |= l.type == LightType::Sun;
+    f.point |= l.type == LightType::Point;
+    f.environment |= l.type == LightType::Environment;
+  }
+  f.multiBounce = scene.render.maxBounces > 1;
+  return f;
+}
+
+}  // namespace plume
