@@ -17,7 +17,9 @@
 layout(std430, binding = BIND_RS_PARAMS) readonly buffer RestirParamBuffer { RestirParams rsp; };
 // Reservoir sets: [set * pixels + pixel].
 layout(std430, binding = BIND_RS_RESERVOIRS) buffer ReservoirBuffer { RsPacked rsReservoirs[]; };
-layout(std430, binding = BIND_RS_PATHS) buffer PathBuffer { RsPathHead rsPaths[]; };
+// Path heads as stored: two uvec4 per RsPathHead (its C++ layout), loaded and stored whole by
+// rs_load_head / rs_store_head (restir/bridge.glsl): two vector accesses instead of one per field.
+layout(std430, binding = BIND_RS_PATHS) buffer PathBuffer { uvec4 rsPathWords[]; };
 // Vertices 2..n of each stored path: [(set * pixels + pixel) * stride + i - 2] = (w_i, t_i).
 layout(std430, binding = BIND_RS_BOUNCES) buffer BounceBuffer { vec4 rsBounces[]; };
 // Progressive accumulation of final shading: [2 * pixel] = (mean rgb, n), [2 * pixel + 1] = (M2 rgb, 0).

@@ -96,12 +96,40 @@ RsReservoir rs_load(uint set, uint pixelIndex) {
 
 void rs_store(uint set, uint pixelIndex, RsReservoir r) { rsReservoirs[rs_slot(set, pixelIndex)] = rs_pack(r); }
 
+RsPathHead rs_load_head(uint set, uint pixelIndex) {
+  uint i = 2u * rs_slot(set, pixelIndex);
+  uvec4 a = rsPathWords[i];
+  uvec4 b = rsPathWords[i + 1u];
+  RsPathHead h;
+  h.lightSample = uintBitsToFloat(a.xy);
+  h.t1 = uintBitsToFloat(a.z);
+  h.vertexCount = a.w;
+  h.light = b.x;
+  h.kinds = b.y;
+  h.uv = b.z;
+  h.pad0 = b.w;
+  return h;
+}
+
+void rs_store_head(uint set, uint pixelIndex, RsPathHead h) {
+  uint i = 2u * rs_slot(set, pixelIndex);
+  rsPathWords[i] = uvec4(floatBitsToUint(h.lightSample), floatBitsToUint(h.t1), h.vertexCount);
+  rsPathWords[i + 1u] = uvec4(h.light, h.kinds, h.uv, h.pad0);
+}
+
+// Vertex count of the stored path (0: none), and marking a slot empty.
+uint rs_path_length(uint set, uint pixelIndex) { return rsPathWords[2u * rs_slot(set, pixelIndex)].w; }
+void rs_clear_path(uint set, uint pixelIndex) { rsPathWords[2u * rs_slot(set, pixelIndex)].w = 0u; }
+
 void rs_copy_path(uint srcSet, uint srcPixel, uint dstSet, uint dstPixel) {
-  RsPathHead h = rsPaths[rs_slot(srcSet, srcPixel)];
-  rsPaths[rs_slot(dstSet, dstPixel)] = h;
+  uint s = 2u * rs_slot(srcSet, srcPixel);
+  uint d = 2u * rs_slot(dstSet, dstPixel);
+  uvec4 head = rsPathWords[s];
+  rsPathWords[d] = head;
+  rsPathWords[d + 1u] = rsPathWords[s + 1u];
   uint a = rs_bounce_base(srcSet, srcPixel);
   uint b = rs_bounce_base(dstSet, dstPixel);
-  for (uint i = 1u; i < h.vertexCount; ++i) rsBounces[b + i - 1u] = rsBounces[a + i - 1u];
+  for (uint i = 1u; i < head.w; ++i) rsBounces[b + i - 1u] = rsBounces[a + i - 1u];
 }
 
 // --- The path contribution f_D(y) ----------------------------------------------------------------
@@ -110,7 +138,7 @@ void rs_copy_path(uint srcSet, uint srcPixel, uint dstSet, uint dstPixel) {
 // term, RGB, times the shift's Jacobian at each vertex (integrator/vertex.glsl: 1 for media). A
 // vertex with zero density (or outside the volume) makes f = 0: the shift fails.
 vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool unbiased, inout RngState rng) {
-  RsPathHead h = rsPaths[rs_slot(set, pixelIndex)];
+  RsPathHead h = rs_load_head(set, pixelIndex);
   uint n = h.vertexCount;
   if (n == 0u) return vec3(0.0f);
   uint base = rs_bounce_base(set, pixelIndex);

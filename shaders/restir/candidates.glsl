@@ -88,7 +88,7 @@ void rs_generate_candidates(uvec2 pixel, uint pixelIndex, uint outSet) {
   rs_finalize(r);
   if (r.W <= 0.0f) head.vertexCount = 0u;
   rs_store(outSet, pixelIndex, r);
-  rsPaths[rs_slot(outSet, pixelIndex)] = head;
+  rs_store_head(outSet, pixelIndex, head);
 }
 
 #endif

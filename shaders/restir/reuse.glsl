@@ -61,7 +61,7 @@ void rs_reuse(uint outSet, uint outPixel, inout RngState rng) {
   uint selected = RS_MAX_INPUTS;
   for (uint s = 0u; s < in_.count; ++s) {
     RsReservoir rs_ = in_.res[s];
-    bool hasSample = rs_.W > 0.0f && rsPaths[rs_slot(rs_input_set(s), in_.pixel[s])].vertexCount > 0u;
+    bool hasSample = rs_.W > 0.0f && rs_path_length(rs_input_set(s), in_.pixel[s]) > 0u;
     float phC = 0.0f;
     float m = 0.0f;
     if (hasSample) {
@@ -77,7 +77,7 @@ void rs_reuse(uint outSet, uint outPixel, inout RngState rng) {
     out_.w_sum = 0.0f;
     out_.p_hat = 0.0f;
     out_.W = 0.0f;
-    rsPaths[rs_slot(outSet, outPixel)].vertexCount = 0u;
+    rs_clear_path(outSet, outPixel);
   }
   rs_store(outSet, outPixel, out_);
 }

@@ -187,23 +187,23 @@ float vol_track_segment(uint tracker, inout VolTrack s, float a, float b, vec2 v
 }
 
 // At a tentative collision at distance t (index-space point p) of rate mu, in a segment of field
-// value `value`; u is a uniform number drawn with the step.
-void vol_track_event(uint tracker, inout VolTrack s, uint v, vec3 p, float t, float mu, vec2 value, float u,
-                     inout RngState rng) {
+// value `value`, in volume v of density scale `scale`; u is a uniform number drawn with the step.
+void vol_track_event(uint tracker, inout VolTrack s, uint v, float scale, vec3 p, float t, float mu, vec2 value,
+                     float u, inout RngState rng) {
   if (tracker == VOL_TRACK_DELTA) {
-    if (u * mu < vol_sigma_t(v, p)) {
+    if (u * mu < scale * vol_density(v, p)) {
       s.t = t;
       s.hit = true;
       s.stop = true;
     }
   } else if (tracker == VOL_TRACK_RATIO) {
-    s.value *= max(0.0f, 1.0f - vol_sigma_t(v, p) / mu);
+    s.value *= max(0.0f, 1.0f - scale * vol_density(v, p) / mu);
     if (!vol_transmittance_roulette(s.value, rng)) {
       s.value = 0.0f;
       s.stop = true;
     }
   } else if (tracker == VOL_TRACK_RESIDUAL) {
-    s.value *= 1.0f - (vol_sigma_t(v, p) - value.x) / mu;
+    s.value *= 1.0f - (scale * vol_density(v, p) - value.x) / mu;
   }
 }
 
@@ -224,6 +224,7 @@ VolTrack vol_track(uint tracker, uint v, vec3 xWorld, vec3 wWorld, float tMax, f
   VolWalk w;
   if (!vol_walk_start(field, v, o, d, tMax, w)) return s;
   uint steps = 0u;
+  float scale = vol_scale(v);  // sigma_t = scale * d, read once per walk
   float a;
   float b;
   vec2 value;
@@ -239,7 +240,7 @@ VolTrack vol_track(uint tracker, uint v, vec3 xWorld, vec3 wWorld, float tMax, f
       uvec4 h = rng_next4(rng);
       t -= log(1.0f - rng_to_float(h.x)) / mu;
       if (!(t < b)) break;
-      vol_track_event(tracker, s, v, o + t * d, t, mu, value, rng_to_float(h.y), rng);
+      vol_track_event(tracker, s, v, scale, o + t * d, t, mu, value, rng_to_float(h.y), rng);
       if (s.stop) break;
     }
   }
