@@ -21,6 +21,20 @@ void GpuTest::SetUpTestSuite() {
 
 void GpuTest::TearDownTestSuite() {}
 
+// Destroys the shared context when the tests are done, before main returns. Left to the static
+// destructors, it would be destroyed after those of the validation layer (loaded later, so torn
+// down first) and lavapipe's instance would never be freed (LeakSanitizer, tools/test --sanitize).
+class GpuEnvironment : public ::testing::Environment {
+ public:
+  void TearDown() override {
+    GpuTest::compiler_.reset();
+    GpuTest::ctx_.reset();
+  }
+};
+namespace {
+[[maybe_unused]] const auto* const kGpuEnvironment = ::testing::AddGlobalTestEnvironment(new GpuEnvironment);
+}  // namespace
+
 void GpuTest::SetUp() { messagesBefore_ = ctx_->validationMessages(); }
 
 void GpuTest::TearDown() {

@@ -27,6 +27,7 @@ class GpuTest : public ::testing::Test {
   static gpu::ShaderCompiler& compiler() { return *compiler_; }
 
  private:
+  friend class GpuEnvironment;
   static std::unique_ptr<gpu::Context> ctx_;
   static std::unique_ptr<gpu::ShaderCompiler> compiler_;
   uint64_t messagesBefore_ = 0;
