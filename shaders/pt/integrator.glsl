@@ -2,7 +2,8 @@
 // free flights, next-event estimation with ratio tracking to every light, phase sampling, Russian
 // roulette. `frame.spp` samples per pixel per dispatch, merged into a running mean and M2 per
 // pixel (Chan et al.'s parallel variance update) so progressive batches give the variance of the
-// mean. Variant defines: PLUME_HAS_SUN, PLUME_HAS_POINT, PLUME_HAS_ENV, PLUME_MULTI_BOUNCE.
+// mean. Variant defines: PLUME_HAS_SUN, PLUME_HAS_POINT, PLUME_HAS_ENV, PLUME_MULTI_BOUNCE,
+// PLUME_HAS_EMISSION (the medium's emission gathered along every segment by delta tracking).
 // Requires volume/bindings.glsl, scene/bindings.glsl and ptAccum (shaders/passes/pt.comp).
 #ifndef PLUME_PT_INTEGRATOR_GLSL
 #define PLUME_PT_INTEGRATOR_GLSL
@@ -40,7 +41,16 @@ vec3 pt_trace_path(vec3 origin, vec3 dir, inout RngState rng) {
     uint scatterings = 0u;
 #endif
     float t;
+#ifdef PLUME_HAS_EMISSION
+    vec3 emitted;
+    bool collided = vol_sample_collision_emitting(origin, dir, DDA_INF, rng, t, emitted);
+    // Emission along this segment: a path of `scatterings` scattering vertices, counted up to
+    // max_bounces like next-event estimation's (pbrt-v4's volpath does the same).
+    radiance += beta * (vec3(1.0f) - vtx_albedo(VERTEX_MEDIUM)) * emitted;
+    if (!collided) {
+#else
     if (!vol_sample_collision(origin, dir, DDA_INF, rng, t)) {
+#endif
       // Lights are reached by NEE after the first vertex: only camera rays see the environment.
       if (scatterings == 0u) radiance += beta * light_escaped(dir);
       return radiance;

@@ -38,6 +38,11 @@ const uint BIND_RS_COUNTERS = 17u;     // uint[]: [0] reservoirs dropped for non
 const uint BIND_LIGHT_CHOICE = 18u;    // GpuLightChoice[]
 const uint RS_BINDING_COUNT = 19u;
 
+// A medium's emission (shaders/volume/bindings.glsl with PLUME_HAS_EMISSION), every estimator.
+const uint BIND_EMISSION_ATLAS = 19u;  // sampler3D: the emission grid in the atlas layout, R32F
+const uint BIND_BLACKBODY = 20u;       // vec4[]: the blackbody table (shared/blackbody.h)
+const uint EMISSION_BINDING_COUNT = 21u;  // binding tables that may hold the emission extend to it
+
 PLUME_NS_END
 
 #endif

@@ -31,10 +31,20 @@ struct GpuVolume {
   vec3 boundsMin;        // index-space box where d may be > 0
   float densityScale;    // sigma_t = densityScale * d
   vec3 boundsMax;
-  float pad0;
+  uint emission;         // EMISSION_*: the emission channel's form (scene/scene.h Emission)
   GpuVolumeLevel levels[GPU_MAX_LEVELS];
   uvec4 levelOffset;     // [k]: offset of level k in the majorant buffer (floats)
+  vec3 emissionScale;    // colour form: scale * color; blackbody form: scale (every channel)
+  float temperatureScale;   // blackbody form: T = temperatureScale * (e - temperatureOffset) K
+  float temperatureOffset;
+  float pad1;
+  float pad2;
+  float pad3;
 };
+
+const uint EMISSION_NONE = 0u;
+const uint EMISSION_COLOR = 1u;      // Le = emissionScale * e
+const uint EMISSION_BLACKBODY = 2u;  // Le = emissionScale * B(temperatureScale * (e - temperatureOffset))
 
 // --- The scene -----------------------------------------------------------------------------------
 const uint LIGHT_SUN = 0u;
@@ -102,7 +112,8 @@ static_assert(sizeof(plume::shared::GpuVolumeLevel) == 16, "GpuVolumeLevel layou
 static_assert(offsetof(plume::shared::GpuVolume, brickOrigin) == 128, "GpuVolume layout");
 static_assert(offsetof(plume::shared::GpuVolume, densityScale) == 128 + 60, "GpuVolume layout");
 static_assert(offsetof(plume::shared::GpuVolume, levels) == 128 + 80, "GpuVolume layout");
-static_assert(sizeof(plume::shared::GpuVolume) == 2 * 64 + 5 * 16 + 4 * 16 + 16, "GpuVolume layout");
+static_assert(offsetof(plume::shared::GpuVolume, emissionScale) == 2 * 64 + 5 * 16 + 4 * 16 + 16, "GpuVolume layout");
+static_assert(sizeof(plume::shared::GpuVolume) == 2 * 64 + 5 * 16 + 4 * 16 + 16 + 32, "GpuVolume layout");
 static_assert(sizeof(plume::shared::GpuLight) == 32, "GpuLight layout");
 static_assert(offsetof(plume::shared::GpuLight, emission) == 16, "GpuLight layout");
 static_assert(sizeof(plume::shared::GpuLightChoice) == 8, "GpuLightChoice layout");

@@ -2,6 +2,7 @@
 // An estimator that needs more of the volume says so before including this file:
 //   PLUME_VOL_MEAN_FIELD  the per-voxel mean field (ReSTIR's sampling and target field)
 //   PLUME_VOL_PREVIOUS    the previous frame's volume, with its mean field (temporal reuse)
+// and a scene whose medium emits defines PLUME_HAS_EMISSION (render/features.cpp).
 #ifndef PLUME_VOLUME_BINDINGS_GLSL
 #define PLUME_VOLUME_BINDINGS_GLSL
 
@@ -18,6 +19,12 @@ layout(std430, binding = BIND_VOLUME_COUNTERS) buffer CounterBuffer { uint volCo
 #if defined(PLUME_VOL_MEAN_FIELD) || defined(PLUME_VOL_PREVIOUS)
 // Per atlas slot 512 words: each voxel's mean and residual bound as two float16.
 layout(std430, binding = BIND_MEAN_FIELD) readonly buffer MeanFieldBuffer { uint volMeanField[]; };
+#endif
+
+#ifdef PLUME_HAS_EMISSION
+// The emission grid in the density's slots (bake.h emissionF32), and the blackbody table.
+layout(binding = BIND_EMISSION_ATLAS) uniform sampler3D volEmissionAtlas;
+layout(std430, binding = BIND_BLACKBODY) readonly buffer BlackbodyBuffer { vec4 volBlackbody[]; };
 #endif
 
 #ifdef PLUME_VOL_PREVIOUS

@@ -45,23 +45,55 @@ ivec3 vol_slot_coords(uint packed) {
   return ivec3(int(packed & 1023u), int((packed >> 10u) & 1023u), int(packed >> 20u));
 }
 
-// Density d at an index-space point (not yet multiplied by the density scale).
-float vol_density(uint v, vec3 p) {
+// Where the trilinear lookup at index-space point p reads volume v's atlas: the texel t of voxel
+// floor(p) (its 8 corners are t + {0,1}³) and the weights' fractions f. False where p's brick is
+// empty (every lookup there is 0).
+bool vol_locate(uint v, vec3 p, out ivec3 t, out vec3 f) {
   vec3 fl = floor(p);
   ivec3 vox = ivec3(fl);
   ivec3 b = vox >> 3;
   uint slot = vol_packed_slot(v, b);
-  if (slot == 0u) return 0.0f;
-  vec3 f = p - fl;
-  ivec3 t = vol_slot_coords(slot) * VOL_TEXELS + (vox - b * VOL_BRICK) + 1;
+  f = p - fl;
+  t = vol_slot_coords(slot) * VOL_TEXELS + (vox - b * VOL_BRICK) + 1;
+  return slot != 0u;
+}
+
+// Corner c's trilinear weight (exact: the product of the fractions, no hardware filtering).
+float vol_corner_weight(int c, vec3 f) {
+  return ((c & 1) != 0 ? f.x : 1.0f - f.x) * ((c & 2) != 0 ? f.y : 1.0f - f.y) * ((c & 4) != 0 ? f.z : 1.0f - f.z);
+}
+
+// Density d at an index-space point (not yet multiplied by the density scale).
+float vol_density(uint v, vec3 p) {
+  ivec3 t;
+  vec3 f;
+  if (!vol_locate(v, p, t, f)) return 0.0f;
   float sum = 0.0f;
-  for (int c = 0; c < 8; ++c) {
-    ivec3 o = ivec3(c & 1, (c >> 1) & 1, (c >> 2) & 1);
-    float w = (o.x != 0 ? f.x : 1.0f - f.x) * (o.y != 0 ? f.y : 1.0f - f.y) * (o.z != 0 ? f.z : 1.0f - f.z);
-    sum += w * vol_texel(v, t + o);
-  }
+  for (int c = 0; c < 8; ++c) sum += vol_corner_weight(c, f) * vol_texel(v, t + ivec3(c & 1, (c >> 1) & 1, (c >> 2) & 1));
   return sum;
 }
+
+#ifdef PLUME_HAS_EMISSION
+#define BB_TABLE(i) volBlackbody[i].rgb
+#include "../shared/blackbody.h"
+
+// The emitted radiance Le at an index-space point of the current volume (DESIGN §2 "Emission"):
+// the emission grid e interpolated like the density, then the colour form emissionScale * e or
+// the blackbody form emissionScale * B(temperatureScale * (e - temperatureOffset)). The medium
+// emits sigma_a * Le per unit length.
+vec3 vol_emitted_radiance(vec3 p) {
+  ivec3 t;
+  vec3 f;
+  if (!vol_locate(VOL_CURRENT, p, t, f)) return vec3(0.0f);
+  float e = 0.0f;
+  for (int c = 0; c < 8; ++c) e += vol_corner_weight(c, f) * texelFetch(volEmissionAtlas, t + ivec3(c & 1, (c >> 1) & 1, (c >> 2) & 1), 0).r;
+#ifdef PLUME_EMISSION_BLACKBODY
+  return vol.emissionScale * bb_lookup(vol.temperatureScale * (e - vol.temperatureOffset));
+#else
+  return vol.emissionScale * e;
+#endif
+}
+#endif
 
 float vol_scale(uint v) { return VOL_PARAM(v, densityScale); }
 bool vol_is_empty(uint v) { return VOL_PARAM(v, empty) != 0; }

@@ -125,6 +125,7 @@ const uint VOL_TRACK_RATIO = 1u;     // ratio tracking: an unbiased transmittanc
 const uint VOL_TRACK_RESIDUAL = 2u;  // residual ratio tracking against the mean field (unbiased)
 const uint VOL_TRACK_TAU = 3u;       // the mean field's optical depth (deterministic)
 const uint VOL_TRACK_SAMPLE = 4u;    // a collision in the mean field, pdf in closed form
+const uint VOL_TRACK_DELTA_EMIT = 5u;  // delta tracking that also gathers the medium's emission
 
 struct VolTrack {
   float value;  // RATIO, RESIDUAL: the transmittance estimate; TAU: the optical depth;
@@ -133,6 +134,9 @@ struct VolTrack {
   float sigma;  // SAMPLE: the mean field's sigma_t at the collision
   bool hit;     // DELTA, SAMPLE: a collision was found
   bool stop;    // the walk ends now (a hit, a transmittance ended by roulette, the step cap)
+#ifdef PLUME_HAS_EMISSION
+  vec3 emitted; // DELTA_EMIT: sum of sigma_t Le / mu over the tentative collisions up to the hit
+#endif
 };
 
 // Russian roulette on a transmittance estimate (unbiased): below VOL_RR_TRANSMITTANCE it
@@ -164,7 +168,9 @@ bool vol_track_alive(uint tracker, VolTrack s) {
 // On entering segment [a, b) with field value `value`: returns the rate of the tentative
 // collisions the tracker wants there (0: none).
 float vol_track_segment(uint tracker, inout VolTrack s, float a, float b, vec2 value) {
-  if (tracker == VOL_TRACK_DELTA || tracker == VOL_TRACK_RATIO) return value.x;  // the majorant
+  if (tracker == VOL_TRACK_DELTA || tracker == VOL_TRACK_RATIO || tracker == VOL_TRACK_DELTA_EMIT) {
+    return value.x;  // the majorant
+  }
   if (tracker == VOL_TRACK_RESIDUAL) {
     // The control's transmittance in closed form, the residual by ratio tracking at mu.
     s.value *= exp(-value.x * (b - a));
@@ -205,6 +211,21 @@ void vol_track_event(uint tracker, inout VolTrack s, uint v, float scale, vec3 p
   } else if (tracker == VOL_TRACK_RESIDUAL) {
     s.value *= 1.0f - (scale * vol_density(v, p) - value.x) / mu;
   }
+#ifdef PLUME_HAS_EMISSION
+  else if (tracker == VOL_TRACK_DELTA_EMIT) {
+    // Every tentative collision, the one that turns out real included, adds sigma_t Le / mu: a
+    // point of the majorant's Poisson process is reached with probability T(t) (delta tracking's
+    // survival is the transmittance), so the sum estimates the integral of T sigma_t Le up to the
+    // collision (pbrt-v4's emission at majorant events); times 1 - albedo it is sigma_a Le.
+    float sigma = scale * vol_density(v, p);
+    s.emitted += (sigma / mu) * vol_emitted_radiance(p);
+    if (u * mu < sigma) {
+      s.t = t;
+      s.hit = true;
+      s.stop = true;
+    }
+  }
+#endif
 }
 
 // The walk. `init`: the tracker's starting value (RATIO, RESIDUAL 1; TAU 0; SAMPLE the optical
@@ -217,7 +238,10 @@ VolTrack vol_track(uint tracker, uint v, vec3 xWorld, vec3 wWorld, float tMax, f
   s.sigma = 0.0f;
   s.hit = false;
   s.stop = false;
-  uint field = tracker <= VOL_TRACK_RATIO ? VOL_FIELD_MAJORANT : VOL_FIELD_MEAN;
+#ifdef PLUME_HAS_EMISSION
+  s.emitted = vec3(0.0f);
+#endif
+  uint field = (tracker <= VOL_TRACK_RATIO || tracker == VOL_TRACK_DELTA_EMIT) ? VOL_FIELD_MAJORANT : VOL_FIELD_MEAN;
   vec3 o;
   vec3 d;
   vol_ray_to_index(v, xWorld, wWorld, o, d);
@@ -255,6 +279,19 @@ bool vol_sample_collision(vec3 oWorld, vec3 dWorld, float tMax, inout RngState r
   tHit = s.t;
   return s.hit;
 }
+
+#ifdef PLUME_HAS_EMISSION
+// Delta tracking as vol_sample_collision, and the radiance the medium emits towards the ray's
+// origin up to the collision (or tMax), divided by the albedo's complement: `emitted` times
+// (1 - albedo) is an unbiased estimate of the integral of T sigma_a Le.
+bool vol_sample_collision_emitting(vec3 oWorld, vec3 dWorld, float tMax, inout RngState rng, out float tHit,
+                                   out vec3 emitted) {
+  VolTrack s = vol_track(VOL_TRACK_DELTA_EMIT, VOL_CURRENT, oWorld, dWorld, tMax, 0.0f, rng);
+  tHit = s.t;
+  emitted = s.emitted;
+  return s.hit;
+}
+#endif
 
 // Ratio tracking: an unbiased estimate of the transmittance over (0, tMax), with Russian
 // roulette once it is small (vol_transmittance_roulette).

@@ -353,6 +353,48 @@ BakedVolume bakeVolume(const LoadedGrid& loaded, const BakeOptions& opt) {
   return vol;
 }
 
+void bakeEmission(BakedVolume& vol, const LoadedGrid& density, const LoadedGrid& emission) {
+  const std::string where = (emission.path.empty() ? std::string("<memory>") : emission.path) + " (grid \"" +
+                            emission.name + "\")";
+  const openvdb::Mat4d a = density.grid->transform().baseMap()->getAffineMap()->getMat4();
+  const openvdb::Mat4d b = emission.grid->transform().baseMap()->getAffineMap()->getMat4();
+  double scale = 0.0, diff = 0.0;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) scale = std::max(scale, std::abs(a(i, j))), diff = std::max(diff, std::abs(a(i, j) - b(i, j)));
+  if (diff > 1e-6 * scale) {
+    throw InputError(where + ": its transform differs from the density grid \"" + density.name +
+                     "\"'s (voxel size " + std::to_string(emission.grid->voxelSize().x()) + " vs " +
+                     std::to_string(density.grid->voxelSize().x()) +
+                     "); emission grids must share the density's voxels (resample it in the tool that wrote it)");
+  }
+  const size_t texels = size_t(vol.atlasTexels.x) * vol.atlasTexels.y * vol.atlasTexels.z;
+  vol.emissionF32.assign(texels, 0.0f);
+  std::vector<std::pair<size_t, uint32_t>> slots;  // (indirection index, slot)
+  for (size_t i = 0; i < vol.indirection.size(); ++i)
+    if (vol.indirection[i] != 0) slots.emplace_back(i, vol.indirection[i]);
+  tbb::combinable<float> maxima([] { return 0.0f; });
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, slots.size()), [&](const auto& r) {
+    openvdb::FloatGrid::ConstAccessor acc = emission.grid->getConstAccessor();
+    Window w;
+    float& mx = maxima.local();
+    for (size_t k = r.begin(); k != r.end(); ++k) {
+      const auto [i, slot] = slots[k];
+      gatherWindow(acc, vol.brickOrigin + delinearize(i, vol.brickDims), w);
+      const glm::ivec3 o = slotTexelOrigin(vol, slot);
+      for (int z = 0; z < kBrickTexels; ++z)
+        for (int y = 0; y < kBrickTexels; ++y) {
+          const size_t row = linearIndex(o + glm::ivec3(0, y, z), vol.atlasTexels);
+          for (int x = 0; x < kBrickTexels; ++x) {
+            const float v = w[windowIndex(x, y, z)];
+            vol.emissionF32[row + size_t(x)] = v;
+            mx = std::max(mx, v);
+          }
+        }
+    }
+  });
+  vol.emissionMax = maxima.combine([](float x, float y) { return std::max(x, y); });
+}
+
 std::vector<uint32_t> packedMeanField(const BakedVolume& vol) {
   std::vector<uint32_t> out(vol.voxelMean.size());
   for (size_t i = 0; i < out.size(); ++i) {  // the values are float16 already: exact conversions

@@ -101,8 +101,17 @@ struct BakedVolume {
   glm::vec3 indexBoundsMin{0.0f}, indexBoundsMax{0.0f};
   glm::vec3 worldBoundsMin{0.0f}, worldBoundsMax{0.0f};
 
+  // The emission grid (DESIGN §2 "Emission"), baked by bakeEmission into the same slots as the
+  // density: texel for texel the atlas layout, always float32 (the blackbody's Wien tail turns
+  // float16's 2^-11 rounding of a temperature into ~1% of radiance at 1500 K). Where the density
+  // brick is empty sigma_a is 0, so emission there cannot contribute and is not stored. Empty
+  // without emission.
+  std::vector<float> emissionF32;
+  float emissionMax = 0;  // max stored emission texel
+
   BakeStats stats;
   bool empty() const { return slotCount <= 1; }
+  bool hasEmission() const { return !emissionF32.empty(); }
 };
 
 struct MemoryReport {
@@ -115,6 +124,11 @@ struct MemoryReport {
 // InputError naming the file when the grid does not fit the atlas or the dense indirection.
 BakedVolume bakeVolume(const LoadedGrid& grid, const BakeOptions& options = {});
 
+// Adds the emission channel: `emission`'s texels in every slot of `vol` (baked from the density
+// grid `density`). Throws InputError naming the file and grids when the emission grid's
+// transform differs from the density's (a resampling would change the field's values).
+void bakeEmission(BakedVolume& vol, const LoadedGrid& density, const LoadedGrid& emission);
+
 MemoryReport memoryReport(const BakedVolume& vol);
 
 // --- CPU mirrors of the shader lookups (all positions in index space) ------------------------
@@ -126,6 +140,7 @@ float sampleDensity(const BakedVolume& vol, glm::vec3 p);   // trilinear, 8 fetc
 float sampleMajorant(const BakedVolume& vol, glm::vec3 p);  // = sampleMaxLevel(vol, 0, p)
 float sampleMaxLevel(const BakedVolume& vol, int level, glm::vec3 p);
 float sampleVoxelMean(const BakedVolume& vol, glm::vec3 p);  // voxelMean of the voxel holding p
+float sampleEmission(const BakedVolume& vol, glm::vec3 p);   // trilinear in the emission channel
 // The mean field as the GPU buffer holds it: per voxel one word, the float16 mean in the low
 // half and the float16 residual bound in the high half (GLSL unpackHalf2x16 .x, .y).
 std::vector<uint32_t> packedMeanField(const BakedVolume& vol);

@@ -59,7 +59,8 @@ float atlasTexel(const BakedVolume& vol, glm::ivec3 t) {
 // d(p) = sum over corners c in {0,1}³ of w_c * v(floor(p) + c), with the exact weights
 // w_c = prod_axis (c ? f : 1 - f), f = p - floor(p). Voxel v of brick b sits at texel
 // (v - 8b) + 1 of its slot (the apron shifts by one), and v + 1 is still inside the window.
-float sampleDensity(const BakedVolume& vol, glm::vec3 p) {
+template <typename Texel>
+float trilinear(const BakedVolume& vol, glm::vec3 p, Texel&& texel) {
   const glm::vec3 fl = glm::floor(p);
   const glm::ivec3 v = glm::ivec3(fl);
   const glm::ivec3 b = brickOfVoxel(v);
@@ -71,9 +72,18 @@ float sampleDensity(const BakedVolume& vol, glm::vec3 p) {
   for (int c = 0; c < 8; ++c) {
     const glm::ivec3 o((c & 1), (c >> 1) & 1, (c >> 2) & 1);
     const float w = (o.x ? f.x : 1.0f - f.x) * (o.y ? f.y : 1.0f - f.y) * (o.z ? f.z : 1.0f - f.z);
-    sum += w * atlasTexel(vol, t + o);
+    sum += w * texel(t + o);
   }
   return sum;
+}
+
+float sampleDensity(const BakedVolume& vol, glm::vec3 p) {
+  return trilinear(vol, p, [&](glm::ivec3 t) { return atlasTexel(vol, t); });
+}
+
+float sampleEmission(const BakedVolume& vol, glm::vec3 p) {
+  if (!vol.hasEmission()) return 0.0f;
+  return trilinear(vol, p, [&](glm::ivec3 t) { return vol.emissionF32[linearIndex(t, vol.atlasTexels)]; });
 }
 
 float sampleMaxLevel(const BakedVolume& vol, int level, glm::vec3 p) {

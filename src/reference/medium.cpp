@@ -176,6 +176,20 @@ bool ReferenceMedium::sampleCollision(const Ray& ray, double tMax, Pcg32& rng, c
   return hit;
 }
 
+bool ReferenceMedium::sampleCollision(const Ray& ray, double tMax, Pcg32& rng, const Accessor& acc, double& tHit,
+                                      TrackingStats& stats,
+                                      const std::function<void(double, double, double)>& onTentative) const {
+  bool hit = false;
+  trackMajorants(ray, tMax, rng, acc, stats, [&](double t, double sigma, double maj) {
+    onTentative(t, sigma, maj);
+    if (!(double(rng.uniform()) * maj < sigma)) return true;
+    tHit = t;
+    hit = true;
+    return false;
+  });
+  return hit;
+}
+
 double ReferenceMedium::ratioTracking(const Ray& ray, double tMax, Pcg32& rng, const Accessor& acc,
                                       TrackingStats& stats) const {
   double transmittance = 1.0;

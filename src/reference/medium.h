@@ -15,6 +15,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 namespace plume::ref {
@@ -49,6 +50,11 @@ class ReferenceMedium {
   // Delta tracking: the first real collision in (0, tMax); false if the ray gets through.
   bool sampleCollision(const Ray& ray, double tMax, Pcg32& rng, const Accessor& acc, double& tHit,
                        TrackingStats& stats) const;
+  // Delta tracking as sampleCollision that also hands every tentative collision, the real one
+  // included, to onTentative(t, sigma_t, majorant) before deciding it (emission estimators sum
+  // sigma_t Le / majorant over them).
+  bool sampleCollision(const Ray& ray, double tMax, Pcg32& rng, const Accessor& acc, double& tHit,
+                       TrackingStats& stats, const std::function<void(double, double, double)>& onTentative) const;
   // Ratio tracking estimate of the transmittance over (0, tMax) (unbiased, in [0, 1]).
   double ratioTracking(const Ray& ray, double tMax, Pcg32& rng, const Accessor& acc,
                        TrackingStats& stats) const;

@@ -3,6 +3,8 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/progress.h"
+#include "media/vdb_loader.h"
+#include "reference/emission.h"
 #include "reference/medium.h"
 #include "shaders/shared/phase.h"
 #include "shaders/shared/sampling.h"
@@ -13,6 +15,8 @@
 #include <tbb/parallel_for.h>
 
 #include <chrono>
+#include <memory>
+#include <optional>
 #include <cmath>
 #include <vector>
 
@@ -41,6 +45,7 @@ struct Context {
   int maxBounces;
   int rrStartBounce;
   dvec3 environment{0};  // sum of constant environment radiance seen by escaping camera rays
+  const ReferenceEmission* emission = nullptr;  // the medium emits
   TrackingStats* tracking;
 };
 
@@ -123,13 +128,27 @@ dvec3 estimateDirect(const Context& c, const dvec3& x, const dvec3& rayDir, Pcg3
   return sum;
 }
 
-// One camera path. Emission and surfaces are refused earlier (checkReferenceSupports).
-dvec3 tracePath(const Context& c, Ray ray, Pcg32& rng, const ReferenceMedium::Accessor& acc) {
+// One camera path. Surfaces and environment maps are refused earlier (checkReferenceSupports).
+dvec3 tracePath(const Context& c, Ray ray, Pcg32& rng, const ReferenceMedium::Accessor& acc,
+                const ReferenceEmission::Accessor* emissionAcc) {
   dvec3 radiance(0), beta(1);
   const double inf = std::numeric_limits<double>::infinity();
   for (int scatterings = 0;; ) {
     double t;
-    if (!c.medium->sampleCollision(ray, inf, rng, acc, t, *c.tracking)) {
+    bool collided;
+    if (c.emission) {
+      // Emission along the segment: sigma_t Le / majorant at every tentative collision estimates
+      // the integral of T sigma_t Le; times 1 - albedo it is the integral of T sigma_a Le. The
+      // path has `scatterings` scattering vertices, at most max_bounces as next-event estimation's.
+      dvec3 emitted(0);
+      collided = c.medium->sampleCollision(ray, inf, rng, acc, t, *c.tracking, [&](double s, double sigma, double maj) {
+        if (sigma > 0.0) emitted += sigma / maj * c.emission->radiance(*emissionAcc, ray.origin + s * ray.direction);
+      });
+      radiance += beta * (dvec3(1.0) - c.albedo) * emitted;
+    } else {
+      collided = c.medium->sampleCollision(ray, inf, rng, acc, t, *c.tracking);
+    }
+    if (!collided) {
       // Escaped. Light sources are reached by next-event estimation after the first vertex,
       // so only camera rays add the environment seen directly.
       if (scatterings == 0) radiance += beta * c.environment;
@@ -180,11 +199,6 @@ void checkReferenceSupports(const Scene& scene) {
   if (!scene.surfaces.empty()) {
     throw InputError(scene.path + ": surfaces: not supported by the CPU reference yet");
   }
-  for (size_t i = 0; i < scene.media.size(); ++i) {
-    if (scene.media[i].emission) {
-      throw InputError(scene.path + strf(": media[%zu].emission: not supported by the CPU reference yet", i));
-    }
-  }
   for (size_t i = 0; i < scene.lights.size(); ++i) {
     if (!scene.lights[i].map.empty()) {
       throw InputError(scene.path + strf(": lights[%zu].map: environment maps are not supported by the CPU reference yet", i));
@@ -212,6 +226,13 @@ Image renderReference(const Scene& scene, openvdb::FloatGrid::ConstPtr density,
   for (const PreparedLight& l : ctx.lights) {
     if (l.type == LightType::Environment) ctx.environment += l.radiance;
   }
+  std::unique_ptr<ReferenceEmission> emission;
+  if (m.emission) {
+    openvdb::FloatGrid::ConstPtr grid = options.emission;
+    if (!grid) grid = loadFloatGrid(m.vdbPath(options.frame), m.emission->grid).grid;
+    emission = std::make_unique<ReferenceEmission>(grid, *m.emission);
+    ctx.emission = emission.get();
+  }
 
   const CameraFrame frame = cameraFrame(cam, options.frame);
   const int ts = options.tileSize;
@@ -224,6 +245,8 @@ Image renderReference(const Scene& scene, openvdb::FloatGrid::ConstPtr density,
   const auto start = std::chrono::steady_clock::now();
   tbb::parallel_for(tbb::blocked_range<int>(0, tilesX * tilesY, 1), [&](const tbb::blocked_range<int>& r) {
     ReferenceMedium::Accessor acc = medium.accessor();
+    std::optional<ReferenceEmission::Accessor> emissionAcc;
+    if (emission) emissionAcc.emplace(emission->accessor());
     for (int tile = r.begin(); tile != r.end(); ++tile) {
       const int x0 = (tile % tilesX) * ts, y0 = (tile / tilesX) * ts;
       for (int py = y0; py < std::min(y0 + ts, cam.height); ++py) {
@@ -232,7 +255,7 @@ Image renderReference(const Scene& scene, openvdb::FloatGrid::ConstPtr density,
           dvec3 sum(0), sumSq(0);
           for (int s = 0; s < rs.spp; ++s) {
             double u = rng.uniform(), v = rng.uniform();
-            dvec3 L = tracePath(ctx, cameraRay(frame, cam, px, py, u, v), rng, acc);
+            dvec3 L = tracePath(ctx, cameraRay(frame, cam, px, py, u, v), rng, acc, emissionAcc ? &*emissionAcc : nullptr);
             sum += L;
             sumSq += L * L;
           }

@@ -8,6 +8,8 @@ gpu::ShaderDefines FeatureSet::defines() const {
   if (point) d.emplace_back("PLUME_HAS_POINT", "1");
   if (environment) d.emplace_back("PLUME_HAS_ENV", "1");
   if (multiBounce) d.emplace_back("PLUME_MULTI_BOUNCE", "1");
+  if (emission) d.emplace_back("PLUME_HAS_EMISSION", "1");
+  if (blackbody) d.emplace_back("PLUME_EMISSION_BLACKBODY", "1");
   return d;
 }
 
@@ -22,6 +24,7 @@ std::string FeatureSet::name() const {
   add(point, "point");
   add(environment, "env");
   add(multiBounce, "multi");
+  add(emission, blackbody ? "blackbody" : "emission");
   return n.empty() ? "none" : n;
 }
 
@@ -32,7 +35,13 @@ FeatureSet featuresOf(const Scene& scene) {
     f.point |= l.type == LightType::Point;
     f.environment |= l.type == LightType::Environment;
   }
-  f.multiBounce = scene.render.maxBounces > 1;
+  for (const Medium& m : scene.media) {
+    f.emission |= m.emission.has_value();
+    f.blackbody |= m.emission && m.emission->blackbody;
+  }
+  // With emission a path also gathers light along the segment after its last scattering, so one
+  // bounce already needs the path loop.
+  f.multiBounce = scene.render.maxBounces > 1 || (f.emission && scene.render.maxBounces >= 1);
   return f;
 }
 

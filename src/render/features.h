@@ -15,6 +15,7 @@ namespace plume {
 // (Whether tracking skips empty space is a property of the volume: see PathTracer::setVolume.)
 struct FeatureSet {
   bool sun = false, point = false, environment = false, multiBounce = false;
+  bool emission = false, blackbody = false;  // the medium emits (blackbody: its colour form)
   gpu::ShaderDefines defines() const;
   std::string name() const;  // e.g. "sun+env+multi"
 };

@@ -9,10 +9,13 @@
 
 namespace plume {
 
-void checkGpuSupports(const Scene& scene, const std::string& renderer) {
+void checkGpuSupports(const Scene& scene, const std::string& renderer, bool emission) {
   if (!scene.surfaces.empty()) throw InputError(scene.path + ": surfaces: not supported by " + renderer + " yet");
   for (size_t i = 0; i < scene.media.size(); ++i) {
-    if (scene.media[i].emission) throw InputError(scene.path + strf(": media[%zu].emission: not supported yet", i));
+    if (scene.media[i].emission && !emission) {
+      throw InputError(scene.path + strf(": media[%zu].emission: not supported by ", i) + renderer +
+                       " yet (render it with --mode pt)");
+    }
   }
   for (size_t i = 0; i < scene.lights.size(); ++i) {
     if (!scene.lights[i].map.empty()) throw InputError(scene.path + strf(": lights[%zu].map: not supported yet", i));

@@ -1,5 +1,6 @@
 #include "render/gpu_volume.h"
 
+#include "core/blackbody.h"
 #include "core/error.h"
 #include "core/log.h"
 
@@ -15,7 +16,8 @@ uint64_t newSerial() {
 }
 }  // namespace
 
-GpuVolumeResources::GpuVolumeResources(gpu::Context& ctx, const BakedVolume& bake, float densityScale) {
+GpuVolumeResources::GpuVolumeResources(gpu::Context& ctx, const BakedVolume& bake, float densityScale,
+                                       const Emission* emission) {
   serial_ = newSerial();
   using namespace shared;
   const bool empty = bake.empty();
@@ -80,6 +82,24 @@ GpuVolumeResources::GpuVolumeResources(gpu::Context& ctx, const BakedVolume& bak
   counters_ = gpu::Buffer(ctx, 16, storage, "tracking counters");
   resetCounters();
   bytes_ = sizeof(params_) + atlasBytes + bake.indirection.size() * 4 + majorants.size() * 4 + coarse.size() * 4;
+
+  if (bake.hasEmission() != (emission != nullptr)) {
+    throw InternalError("volume upload: the bake's emission channel and the medium's emission settings disagree");
+  }
+  if (emission) {
+    hasEmission_ = true;
+    params_.emission = emission->blackbody ? EMISSION_BLACKBODY : EMISSION_COLOR;
+    params_.emissionScale = emission->blackbody ? glm::vec3(emission->scale) : emission->scale * emission->color;
+    params_.temperatureScale = emission->temperatureScale;
+    params_.temperatureOffset = emission->temperatureOffset;
+    paramBuffer_.upload(&params_, sizeof(params_));
+    emissionAtlas_ = gpu::Image3D(ctx, bake.atlasTexels, VK_FORMAT_R32_SFLOAT, 4, "emission atlas");
+    emissionAtlas_.upload(bake.emissionF32.data(), bake.emissionF32.size() * 4);
+    const std::vector<glm::vec4> table = blackbodyTable();
+    blackbody_ = gpu::Buffer(ctx, table.size() * sizeof(glm::vec4), storage, "blackbody table");
+    blackbody_.upload(table.data(), table.size() * sizeof(glm::vec4));
+    bytes_ += bake.emissionF32.size() * 4 + table.size() * sizeof(glm::vec4);
+  }
 }
 
 void GpuVolumeResources::setDensityScale(float densityScale) {
@@ -95,6 +115,10 @@ void GpuVolumeResources::bind(gpu::DescriptorSet& set) const {
   set.bind(shared::BIND_INDIRECTION, indirection_);
   set.bind(shared::BIND_MAJORANTS, majorants_);
   set.bind(shared::BIND_VOLUME_COUNTERS, counters_);
+  if (hasEmission_) {
+    set.bind(shared::BIND_EMISSION_ATLAS, emissionAtlas_);
+    set.bind(shared::BIND_BLACKBODY, blackbody_);
+  }
 }
 
 void GpuVolumeResources::bindMeanField(gpu::DescriptorSet& set) const { set.bind(shared::BIND_MEAN_FIELD, coarse_); }

@@ -7,6 +7,7 @@
 #include "gpu/pipeline.h"
 #include "gpu/resources.h"
 #include "media/bake.h"
+#include "scene/scene.h"
 #include "shaders/shared/bindings.h"
 #include "shaders/shared/gpu_types.h"
 
@@ -14,9 +15,13 @@ namespace plume {
 
 class GpuVolumeResources {
  public:
-  GpuVolumeResources(gpu::Context& ctx, const BakedVolume& bake, float densityScale);
+  // `emission`: the medium's emission settings, required when the bake has an emission channel.
+  GpuVolumeResources(gpu::Context& ctx, const BakedVolume& bake, float densityScale,
+                     const Emission* emission = nullptr);
 
-  // Binds params, atlas, indirection, majorants and counters (BIND_VOLUME .. BIND_VOLUME_COUNTERS).
+  // Binds params, atlas, indirection, majorants and counters (BIND_VOLUME .. BIND_VOLUME_COUNTERS),
+  // and with an emission channel the emission atlas and the blackbody table (BIND_EMISSION_ATLAS,
+  // BIND_BLACKBODY).
   void bind(gpu::DescriptorSet& set) const;
   // Binds ReSTIR's mean field (BIND_MEAN_FIELD): 512 words per atlas slot (slot index
   // x + X * (y + Y * z) of the packed slot coordinates), each voxel's mean and residual bound as
@@ -47,6 +52,9 @@ class GpuVolumeResources {
   gpu::Buffer majorants_;
   gpu::Buffer counters_;
   gpu::Buffer coarse_;
+  gpu::Image3D emissionAtlas_;  // with an emission channel only
+  gpu::Buffer blackbody_;
+  bool hasEmission_ = false;
   uint64_t bytes_ = 0;
   uint64_t serial_ = 0;
 };

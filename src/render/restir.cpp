@@ -74,7 +74,7 @@ constexpr uint32_t kSets = 3;  // candidates / temporal / spatial rotate through
 
 Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene, const RestirOptions& options)
     : ctx_(ctx), scene_(scene), options_(options), features_(featuresOf(scene)), timer_(ctx, 32) {
-  checkGpuSupports(scene, "ReSTIR");
+  checkGpuSupports(scene, "ReSTIR", false);
   if (scene.render.maxBounces > int(shared::RS_MAX_VERTICES)) {
     throw InputError(scene.path + strf(": render.max_bounces: ReSTIR stores paths of at most %u vertices (got %d); "
                                        "use mode pt for longer paths",

@@ -9,7 +9,13 @@ VolumeSource::VolumeSource(gpu::Context& ctx, const Medium& medium, const Volume
 
 VolumeSource::Bake VolumeSource::bakeFile(const std::string& path) const {
   LoadedGrid grid = loadFloatGrid(path, medium_.densityGrid);
-  return {bakeVolume(grid, options_.bake), grid.replacedValues};
+  Bake bake{bakeVolume(grid, options_.bake), grid.replacedValues};
+  if (medium_.emission) {  // only a grid the scene uses is loaded
+    LoadedGrid emission = loadFloatGrid(path, medium_.emission->grid);
+    bakeEmission(bake.volume, grid, emission);
+    bake.replacedValues += emission.replacedValues;
+  }
+  return bake;
 }
 
 const GpuVolumeResources& VolumeSource::load(int frame) {
@@ -23,11 +29,11 @@ const GpuVolumeResources& VolumeSource::load(int frame) {
     if (options_.interactive) {
       auto it = bakes_.find(path);  // a still volume is baked once
       if (it == bakes_.end()) it = bakes_.emplace(path, bakeFile(path)).first;
-      current_ = std::make_unique<GpuVolumeResources>(ctx_, it->second.volume, medium_.densityScale);
+      current_ = std::make_unique<GpuVolumeResources>(ctx_, it->second.volume, medium_.densityScale, emission());
       replacedValues_ = it->second.replacedValues;
     } else {
       const Bake bake = bakeFile(path);
-      current_ = std::make_unique<GpuVolumeResources>(ctx_, bake.volume, medium_.densityScale);
+      current_ = std::make_unique<GpuVolumeResources>(ctx_, bake.volume, medium_.densityScale, emission());
       replacedValues_ = bake.replacedValues;
     }
     currentPath_ = path;

@@ -37,7 +37,8 @@ class VolumeSource {
   const GpuVolumeResources& load(int frame);
   // With keepPrevious: the volume of frame - 1 when that was the last one loaded, else null.
   const GpuVolumeResources* previous() const;
-  // Values of the current frame's grid that were NaN, infinite or negative and replaced by 0.
+  // Values of the current frame's grids (density, and emission if used) that were NaN, infinite or
+  // negative and replaced by 0.
   uint64_t replacedValues() const { return replacedValues_; }
 
  private:
@@ -46,6 +47,7 @@ class VolumeSource {
     uint64_t replacedValues = 0;
   };
   Bake bakeFile(const std::string& path) const;
+  const Emission* emission() const { return medium_.emission ? &*medium_.emission : nullptr; }
 
   gpu::Context& ctx_;
   const Medium& medium_;

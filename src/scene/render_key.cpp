@@ -94,7 +94,13 @@ RenderKey sceneRenderKey(const Scene& scene, int frame, const std::function<bool
     key.add(p + "density_scale", num(m.densityScale));
     key.add(p + "albedo", vec(m.albedo));
     key.add(p + "g", num(m.g));
-    key.add(p + "emission", m.emission ? m.emission->grid + " x " + num(m.emission->scale) : "none");
+    std::string emission = "none";
+    if (const auto& e = m.emission) {
+      emission = e->grid + " x " + num(e->scale) +
+                 (e->blackbody ? " blackbody " + num(e->temperatureScale) + " " + num(e->temperatureOffset)
+                               : " color " + num(e->color.x) + " " + num(e->color.y) + " " + num(e->color.z));
+    }
+    key.add(p + "emission", emission);
   }
   for (size_t i = 0; i < scene.lights.size(); ++i) key.add(strf("lights[%zu]", i), lightText(scene, scene.lights[i]));
   for (size_t i = 0; i < scene.surfaces.size(); ++i) {

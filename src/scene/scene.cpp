@@ -169,13 +169,31 @@ Medium parseMedium(const json& j, const std::string& file, const std::string& di
   if (const json* e = r.get("emission")) {
     ObjectReader er(*e, file, kp + ".emission");
     Emission em;
-    em.grid = er.string("grid", "");
     er.require("grid");
+    em.grid = er.string("grid", "");
     em.scale = float(er.number("scale", 1.0, 0.0, 1e12, "in [0, 1e12]"));
+    if (const json* b = er.get("blackbody")) {
+      if (!b->is_boolean()) er.fail(kp + ".emission.blackbody", "expected true or false");
+      em.blackbody = b->get<bool>();
+    }
+    const bool hasColor = er.get("color") != nullptr;
+    em.color = er.vec3("color", em.color, 0.0, 1e12, "in [0, 1e12]");
+    const bool hasTemperature = er.get("temperature_scale") || er.get("temperature_offset");
+    em.temperatureScale = float(er.number("temperature_scale", 1.0, 0.0, 1e12, "in [0, 1e12] (kelvin per grid unit)"));
+    em.temperatureOffset = float(er.number("temperature_offset", 0.0, -1e12, 1e12, "in [-1e12, 1e12]"));
+    if (em.blackbody && hasColor) {
+      er.fail(kp + ".emission.color", "a blackbody emission takes its colour from the temperature: remove \"color\" or \"blackbody\"");
+    }
+    if (!em.blackbody && hasTemperature) {
+      er.fail(kp + ".emission", "\"temperature_scale\" and \"temperature_offset\" need \"blackbody\": true");
+    }
     er.finish();
     m.emission = em;
   }
   r.finish();
+  if (m.emission && m.albedo == glm::vec3(1.0f)) {
+    logWarn(file + ": " + kp + ".emission: the albedo is 1 in every channel, so sigma_a = 0 and the medium emits nothing");
+  }
   return m;
 }
 

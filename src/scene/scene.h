@@ -38,9 +38,19 @@ struct Camera {
   bool moves() const { return !keys.empty(); }
 };
 
+// A medium's emission (DESIGN §2 "Emission"): the medium emits sigma_a(x) * Le(x) radiance per
+// unit length, sigma_a = sigma_t * (1 - albedo), with e(x) the emission grid trilinearly
+// interpolated like the density and
+//   colour:    Le(x) = scale * color * e(x)
+//   blackbody: Le(x) = scale * B(T(x)), T(x) = temperature_scale * (e(x) - temperature_offset)
+//              kelvin, B the normalised blackbody of core/blackbody.h (0 for T <= 100 K).
 struct Emission {
-  std::string grid;   // grid name in the medium's VDB
+  std::string grid;                // grid name in the medium's VDB (same file, same transform)
   float scale = 1.0f;
+  glm::vec3 color{1.0f};           // colour form
+  bool blackbody = false;
+  float temperatureScale = 1.0f;   // blackbody form: kelvin per grid unit
+  float temperatureOffset = 0.0f;  // blackbody form: grid value of 0 K
 };
 
 struct Medium {
