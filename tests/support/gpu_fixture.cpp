@@ -42,14 +42,22 @@ void GpuTest::TearDown() {
 }
 
 Image renderGpuPt(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene,
-                  openvdb::FloatGrid::Ptr grid, int frame, GpuRenderInfo* info, TexelFormat format) {
+                  openvdb::FloatGrid::Ptr grid, int frame, GpuRenderInfo* info, TexelFormat format,
+                  openvdb::FloatGrid::Ptr emission) {
   LoadedGrid loaded;
   loaded.grid = grid;
   loaded.name = "density";
   BakeOptions options;
   options.format = format;
   BakedVolume bake = bakeVolume(loaded, options);
-  GpuVolumeResources volume(ctx, bake, scene.medium().densityScale);
+  if (emission) {
+    LoadedGrid e;
+    e.grid = emission;
+    e.name = "emission";
+    bakeEmission(bake, loaded, e);
+  }
+  const auto& em = scene.medium().emission;
+  GpuVolumeResources volume(ctx, bake, scene.medium().densityScale, emission && em ? &*em : nullptr);
   PathTracer tracer(ctx, compiler, scene);
   tracer.setVolume(volume);
   tracer.beginFrame(frame);

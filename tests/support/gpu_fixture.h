@@ -39,8 +39,9 @@ struct GpuRenderInfo {
 };
 
 // Bakes `grid`, renders scene.render.spp samples per pixel of `frame` with the GPU path tracer.
+// `emission`: the medium's emission grid (scene.medium().emission must be set with it).
 Image renderGpuPt(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene,
                   openvdb::FloatGrid::Ptr grid, int frame = 1, GpuRenderInfo* info = nullptr,
-                  TexelFormat format = TexelFormat::Float16);
+                  TexelFormat format = TexelFormat::Float16, openvdb::FloatGrid::Ptr emission = nullptr);
 
 }  // namespace plume::test
