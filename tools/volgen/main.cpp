@@ -1,5 +1,6 @@
 // plume-volgen: makes the volumes bundled with Plume (see volumes/README.md).
 //   plume-volgen smoke --out volumes/smoke --frames 24 --res 64
+//   plume-volgen fire --out volumes/fire --frames 24 --res 64
 //   plume-volgen procedural --out volumes/procedural
 //   plume-volgen badinputs --out tests/bad_inputs
 //   plume-volgen preview FILE.vdb -o FILE.pgm
@@ -32,6 +33,17 @@ int main(int argc, char** argv) {
   sm->add_option("--seed", smoke.seed, "noise seed")->capture_default_str();
   sm->add_flag("--half,!--no-half", smoke.halfFloat, "store values as 16-bit floats")->capture_default_str();
   sm->callback([&] { action = [&] { return runSmoke(smoke); }; });
+
+  SmokeParams fire = fireDefaults();
+  auto* fi = app.add_subcommand("fire", "the smoke solver as a fire: density, temperature and flame grids per frame");
+  fi->add_option("--out", fire.out, "output folder")->capture_default_str();
+  fi->add_option("--frames", fire.frames, "frames to write")->capture_default_str();
+  fi->add_option("--res", fire.res, "cells per axis (domain is 2 world units wide)")->capture_default_str();
+  fi->add_option("--cooling", fire.cooling, "temperature decay rate, 1/s")->capture_default_str();
+  fi->add_option("--buoyancy", fire.buoyancy, "units/s² per unit temperature")->capture_default_str();
+  fi->add_option("--seed", fire.seed, "noise seed")->capture_default_str();
+  fi->add_flag("--half,!--no-half", fire.halfFloat, "store values as 16-bit floats")->capture_default_str();
+  fi->callback([&] { action = [&] { return runSmoke(fire); }; });
 
   std::string procOut = "volumes/procedural";
   auto* pr = app.add_subcommand("procedural", "sphere, cloud, slab and ramp test grids");

@@ -47,8 +47,17 @@ struct SmokeParams {
   float vorticity = 10.0f; // vorticity confinement epsilon (Fedkiw et al. 2001 eq. 11, h = 1 cell)
   uint32_t seed = 7;
   bool halfFloat = false;
+  // Fire (`plume-volgen fire`): files fire_NNNN.vdb with the grids density, temperature (the
+  // solver's T in [0, 1]) and flame (smoothstep of T from flameLow to flameHigh), the source
+  // injecting sourceDensity times the smoke's density.
+  bool fire = false;
+  float sourceDensity = 1.0f;
+  float sourceTemperature = 1.0f;  // the source sets T = min(1, sourceTemperature * strength)
+  float flameLow = 0.45f, flameHigh = 0.9f;
 };
 int runSmoke(const SmokeParams& p);
+// The defaults of `plume-volgen fire` (volumes/README.md).
+SmokeParams fireDefaults();
 
 int runProcedural(const std::string& outDir);
 int runBadInputs(const std::string& outDir);
