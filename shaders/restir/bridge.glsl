@@ -136,7 +136,8 @@ void rs_copy_path(uint srcSet, uint srcPixel, uint dstSet, uint dstPixel) {
 // y is the path stored at (set, pixel); D any domain. Vertices x_1 = o + t1 d(u, v), x_i = x_{i-1} +
 // t_i w_i; f = prod_i [T(x_{i-1}, x_i) sigma_s(x_i)] * prod_{i>=2} scatter(w_{i-1}, w_i) * light
 // term, RGB, times the shift's Jacobian at each vertex (integrator/vertex.glsl: 1 for media). A
-// vertex with zero density (or outside the volume) makes f = 0: the shift fails.
+// vertex with zero density (or outside the volume) makes f = 0: the shift fails. A path ending in
+// emission has sigma_a(x_n) Le(x_n) in place of sigma_s(x_n) and the light term.
 vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool unbiased, inout RngState rng) {
   RsPathHead h = rs_load_head(set, pixelIndex);
   uint n = h.vertexCount;
@@ -147,6 +148,12 @@ vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool unbiased, 
   float t = h.t1;
   vec3 f = vec3(1.0f);
   uint kind = VERTEX_MEDIUM;
+  // A path ending in emission: its last vertex absorbs (sigma_a Le = sigma_t (1 - albedo) Le)
+  // instead of scattering towards a light.
+  bool emits = false;
+#ifdef PLUME_HAS_EMISSION
+  emits = h.light == RS_LIGHT_EMISSION;
+#endif
   for (uint i = 1u; i <= n; ++i) {
     if (i >= 2u) {
       vec4 b = rsBounces[base + i - 2u];
@@ -159,8 +166,13 @@ vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool unbiased, 
     x += t * w;
     float sigma = vol_sigma_t_world(D.v, x);
     if (!(sigma > 0.0f)) return vec3(0.0f);
-    f *= tr * sigma * vtx_albedo(kind) * vtx_shift_jacobian(kind);
+    vec3 a = vtx_albedo(kind);
+    if (emits && i == n) a = vec3(1.0f) - a;
+    f *= tr * sigma * a * vtx_shift_jacobian(kind);
   }
+#ifdef PLUME_HAS_EMISSION
+  if (emits) return f * vol_emitted_radiance_world(D.v, x);
+#endif
   return f * rs_light_term(D.v, kind, h.light, h.lightSample, x, w, unbiased, rng);
 }
 

@@ -8,7 +8,10 @@
 //   p(y) = prod_i sigma_c(x_i) exp(-tau_i) * prod_{i>=2} phase_i * prod q (Russian roulette)
 //          * p_light,
 // and only "vertex j of some walk, light l" can produce it, so the M walks give it the MIS
-// weight 1/M (GRIS allows candidates of one walk to be dependent: only marginals matter).
+// weight 1/M (GRIS allows candidates of one walk to be dependent: only marginals matter). With an
+// emitting medium (PLUME_HAS_EMISSION) every vertex also ends a candidate with its own emission
+// (sigma_a Le at x_j, pdf without a light factor; light = RS_LIGHT_EMISSION), up to vertex
+// max_bounces + 1: both ends go through the one reservoir, so reuse shares good emitters too.
 // The reservoir's confidence is M. Requires restir/bridge.glsl.
 #ifndef PLUME_RESTIR_CANDIDATES_GLSL
 #define PLUME_RESTIR_CANDIDATES_GLSL
@@ -18,7 +21,12 @@ void rs_generate_candidates(uvec2 pixel, uint pixelIndex, uint outSet) {
   RngState rng = rng_init(pixel, frame.frameKey, RNG_STREAM_CANDIDATES, frame.seed);
   uint M = rsp.candidates;
   float invM = 1.0f / float(M);
-  uint maxVertices = min(frame.maxBounces, RS_MAX_VERTICES);
+  uint maxVertices = min(frame.maxBounces, RS_MAX_VERTICES);  // vertices that scatter to a light
+#ifdef PLUME_HAS_EMISSION
+  uint walkVertices = min(frame.maxBounces + 1u, RS_MAX_VERTICES);  // emission after the last scattering
+#else
+  uint walkVertices = maxVertices;
+#endif
   float q = min(1.0f, plume_max3(vtx_albedo(VERTEX_MEDIUM)));
   uint base = rs_bounce_base(outSet, pixelIndex);
   RsReservoir r = rs_empty();
@@ -39,7 +47,7 @@ void rs_generate_candidates(uvec2 pixel, uint pixelIndex, uint outSet) {
     float pdf = 1.0f;     // prefix of the source pdf
     float t1 = 0.0f;
     uint keep = 0u;  // vertices of this walk's selected candidate (0: none): copied when the walk ends
-    for (uint j = 1u; j <= maxVertices; ++j) {
+    for (uint j = 1u; j <= walkVertices; ++j) {
       float t;
       float sigmaC;
       float tau;
@@ -49,12 +57,27 @@ void rs_generate_candidates(uvec2 pixel, uint pixelIndex, uint outSet) {
       float sigma = vol_sigma_t_world(VOL_CURRENT, x);
       if (!(sigma > 0.0f)) break;  // f = 0 for this path and every extension of it
       pdf *= sigmaC * exp(-tau);   // the sampling field's free-flight pdf
-      f *= trTarget * sigma * vtx_albedo(VERTEX_MEDIUM);
+      vec3 fArrive = f * trTarget * sigma;  // before x_j scatters or absorbs
+      f = fArrive * vtx_albedo(VERTEX_MEDIUM);
       if (j == 1u) {
         t1 = t;
       } else {
         walk[j - 2u] = vec4(w, t);
       }
+#ifdef PLUME_HAS_EMISSION
+      {  // the candidate ending with x_j's emission: sigma_a Le instead of scattering
+        float ph = rs_luminance(fArrive * (vec3(1.0f) - vtx_albedo(VERTEX_MEDIUM)) * vol_emitted_radiance_world(VOL_CURRENT, x));
+        if (rs_update(r, invM * ph / pdf, ph, 0.0f, rng_float(rng))) {
+          head.lightSample = vec2(0.0f);
+          head.t1 = t1;
+          head.vertexCount = j;
+          head.light = RS_LIGHT_EMISSION;
+          head.uv = uv;
+          keep = j;
+        }
+      }
+      if (j > maxVertices) break;  // no scattering beyond max_bounces
+#endif
       uvec4 h = rng_next4(rng);
       uint light;
       vec2 ls;
@@ -71,7 +94,7 @@ void rs_generate_candidates(uvec2 pixel, uint pixelIndex, uint outSet) {
           keep = j;
         }
       }
-      if (j == maxVertices) break;
+      if (j == walkVertices) break;
       if (j >= frame.rrStartBounce) {  // Russian roulette with a fixed probability: part of the pdf
         if (rng_float(rng) >= q) break;
         pdf *= q;

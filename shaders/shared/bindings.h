@@ -41,7 +41,8 @@ const uint RS_BINDING_COUNT = 19u;
 // A medium's emission (shaders/volume/bindings.glsl with PLUME_HAS_EMISSION), every estimator.
 const uint BIND_EMISSION_ATLAS = 19u;  // sampler3D: the emission grid in the atlas layout, R32F
 const uint BIND_BLACKBODY = 20u;       // vec4[]: the blackbody table (shared/blackbody.h)
-const uint EMISSION_BINDING_COUNT = 21u;  // binding tables that may hold the emission extend to it
+const uint BIND_PREV_EMISSION_ATLAS = 21u;  // sampler3D: the previous frame's (ReSTIR's history)
+const uint EMISSION_BINDING_COUNT = 22u;  // binding tables that may hold the emission extend to it
 
 PLUME_NS_END
 

@@ -8,7 +8,9 @@
 //   (w_i, t_i), i = 2..n    direction and distance of each further vertex (n <= RS_MAX_VERTICES)
 //   (light, u)              the light sample that ends the path: light index and two floats
 //                           (a direction for suns with a disk and the environment, unused for a
-//                           delta sun or a point light)
+//                           delta sun or a point light); or light = RS_LIGHT_EMISSION: the path
+//                           ends with the medium's emission at x_n (x_n absorbs instead of
+//                           scattering: sigma_a Le there, n - 1 scattering vertices)
 // Its contribution f_D(y) in a domain D (pixel of a frame, volume) is measured in du dv dt1 dw2 dt2 ... dw_L,
 // so copying the coordinates into another domain has Jacobian 1 and the light reconnection to a
 // direction or a point has none either. A future surface vertex is one more kind of vertex in
@@ -23,6 +25,7 @@ PLUME_NS_BEGIN
 
 const uint RS_MAX_VERTICES = 16u;  // longest path a reservoir stores (render.max_bounces <= this)
 const uint RS_MAX_NEIGHBOURS = 8u;
+const uint RS_LIGHT_EMISSION = 0xFFFFFFFFu;  // RsPathHead.light of a path ending in emission
 
 const uint RS_MIS_PAIRWISE = 0u;  // pairwise MIS with confidence weights (default, O(k))
 const uint RS_MIS_GBH = 1u;       // generalised balance heuristic (O(k^2))
@@ -35,7 +38,7 @@ struct RsPathHead {
   vec2 lightSample;  // the light sample's two floats (rs_encode_dir of a direction, or unused)
   float t1;          // distance of the first vertex along the camera ray
   uint vertexCount;  // n (0: no path)
-  uint light;        // index of the light that ends the path
+  uint light;        // index of the light that ends the path, or RS_LIGHT_EMISSION
   uint kinds;        // vertex kinds, one bit per vertex (integrator/vertex.glsl; 0: all media)
   uint uv;           // sub-pixel position (u, v) as two 16-bit unorms (restir/bridge.glsl)
   uint pad0;

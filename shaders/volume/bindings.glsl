@@ -32,6 +32,9 @@ layout(std430, binding = BIND_PREV_VOLUME) readonly buffer PrevVolumeBuffer { Gp
 layout(binding = BIND_PREV_ATLAS) uniform sampler3D prevAtlas;
 layout(std430, binding = BIND_PREV_INDIRECTION) readonly buffer PrevIndirectionBuffer { uint prevIndirection[]; };
 layout(std430, binding = BIND_PREV_MEAN_FIELD) readonly buffer PrevMeanFieldBuffer { uint prevMeanField[]; };
+#ifdef PLUME_HAS_EMISSION
+layout(binding = BIND_PREV_EMISSION_ATLAS) uniform sampler3D prevEmissionAtlas;
+#endif
 #endif
 
 #endif

@@ -77,20 +77,28 @@ float vol_density(uint v, vec3 p) {
 #define BB_TABLE(i) volBlackbody[i].rgb
 #include "../shared/blackbody.h"
 
-// The emitted radiance Le at an index-space point of the current volume (DESIGN §2 "Emission"):
-// the emission grid e interpolated like the density, then the colour form emissionScale * e or
-// the blackbody form emissionScale * B(temperatureScale * (e - temperatureOffset)). The medium
-// emits sigma_a * Le per unit length.
-vec3 vol_emitted_radiance(vec3 p) {
+#ifdef PLUME_VOL_PREVIOUS
+float vol_emission_texel(uint v, ivec3 t) {
+  return v == VOL_CURRENT ? texelFetch(volEmissionAtlas, t, 0).r : texelFetch(prevEmissionAtlas, t, 0).r;
+}
+#else
+float vol_emission_texel(uint v, ivec3 t) { return texelFetch(volEmissionAtlas, t, 0).r; }
+#endif
+
+// The emitted radiance Le at an index-space point of volume v (DESIGN §2 "Emission"): the
+// emission grid e interpolated like the density, then the colour form emissionScale * e or the
+// blackbody form emissionScale * B(temperatureScale * (e - temperatureOffset)). The medium emits
+// sigma_a * Le per unit length.
+vec3 vol_emitted_radiance(uint v, vec3 p) {
   ivec3 t;
   vec3 f;
-  if (!vol_locate(VOL_CURRENT, p, t, f)) return vec3(0.0f);
+  if (!vol_locate(v, p, t, f)) return vec3(0.0f);
   float e = 0.0f;
-  for (int c = 0; c < 8; ++c) e += vol_corner_weight(c, f) * texelFetch(volEmissionAtlas, t + ivec3(c & 1, (c >> 1) & 1, (c >> 2) & 1), 0).r;
+  for (int c = 0; c < 8; ++c) e += vol_corner_weight(c, f) * vol_emission_texel(v, t + ivec3(c & 1, (c >> 1) & 1, (c >> 2) & 1));
 #ifdef PLUME_EMISSION_BLACKBODY
-  return vol.emissionScale * bb_lookup(vol.temperatureScale * (e - vol.temperatureOffset));
+  return VOL_PARAM(v, emissionScale) * bb_lookup(VOL_PARAM(v, temperatureScale) * (e - VOL_PARAM(v, temperatureOffset)));
 #else
-  return vol.emissionScale * e;
+  return VOL_PARAM(v, emissionScale) * e;
 #endif
 }
 #endif
@@ -116,6 +124,16 @@ float vol_sigma_t_world(uint v, vec3 xWorld) {
   vol_ray_to_index(v, xWorld, vec3(0.0f), o, d);
   return vol_sigma_t(v, o);
 }
+
+#ifdef PLUME_HAS_EMISSION
+// Le at a world point of volume v.
+vec3 vol_emitted_radiance_world(uint v, vec3 xWorld) {
+  vec3 o;
+  vec3 d;
+  vol_ray_to_index(v, xWorld, vec3(0.0f), o, d);
+  return vol_emitted_radiance(v, o);
+}
+#endif
 
 // Majorant of sigma_t in a cell of level `level` of the current volume's hierarchy (level 0:
 // per brick; cells relative to brickOrigin). Only the current volume is tracked against majorants.

@@ -218,7 +218,7 @@ void vol_track_event(uint tracker, inout VolTrack s, uint v, float scale, vec3 p
     // survival is the transmittance), so the sum estimates the integral of T sigma_t Le up to the
     // collision (pbrt-v4's emission at majorant events); times 1 - albedo it is sigma_a Le.
     float sigma = scale * vol_density(v, p);
-    s.emitted += (sigma / mu) * vol_emitted_radiance(p);
+    s.emitted += (sigma / mu) * vol_emitted_radiance(v, p);
     if (u * mu < sigma) {
       s.t = t;
       s.hit = true;

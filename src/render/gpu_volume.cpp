@@ -128,6 +128,7 @@ void GpuVolumeResources::bindAsPrevious(gpu::DescriptorSet& set) const {
   set.bind(shared::BIND_PREV_ATLAS, atlas_);
   set.bind(shared::BIND_PREV_INDIRECTION, indirection_);
   set.bind(shared::BIND_PREV_MEAN_FIELD, coarse_);
+  if (hasEmission_) set.bind(shared::BIND_PREV_EMISSION_ATLAS, emissionAtlas_);
 }
 
 uint32_t GpuVolumeResources::truncatedCount() const {

@@ -28,11 +28,16 @@ gpu::ComputePass& PathTracer::makePass(bool skipEmpty) {
   if (pass) return *pass;
   using gpu::BindingType;
   gpu::ShaderDefines defines = features_.defines();
+  // Every sampled image in a table must be written before a dispatch (lavapipe reads them all):
+  // the emission atlas is in the table of an emitting scene only.
   if (skipEmpty) defines.emplace_back("PLUME_SKIP_EMPTY", "1");
   pass = std::make_unique<gpu::ComputePass>(
       ctx_, compiler_.compile("passes/pt.comp", defines),
-      gpu::bindingTable(shared::EMISSION_BINDING_COUNT, {{shared::BIND_ATLAS, BindingType::SampledImage},
-                                                         {shared::BIND_EMISSION_ATLAS, BindingType::SampledImage}}), 0,
+      features_.emission
+          ? gpu::bindingTable(shared::BIND_BLACKBODY + 1, {{shared::BIND_ATLAS, BindingType::SampledImage},
+                                                            {shared::BIND_EMISSION_ATLAS, BindingType::SampledImage}})
+          : gpu::bindingTable(shared::BIND_PT_ACCUM + 1, {{shared::BIND_ATLAS, BindingType::SampledImage}}),
+      0,
       "path tracing [" + features_.name() + (skipEmpty ? "+skip" : "") + "]", glm::uvec3(8, 8, 1));
   pass->set.bind(shared::BIND_FRAME, frameBuffer_);
   pass->set.bind(shared::BIND_LIGHTS, lightBuffer_);

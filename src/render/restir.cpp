@@ -74,19 +74,30 @@ constexpr uint32_t kSets = 3;  // candidates / temporal / spatial rotate through
 
 Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene, const RestirOptions& options)
     : ctx_(ctx), scene_(scene), options_(options), features_(featuresOf(scene)), timer_(ctx, 32) {
-  checkGpuSupports(scene, "ReSTIR", false);
-  if (scene.render.maxBounces > int(shared::RS_MAX_VERTICES)) {
-    throw InputError(scene.path + strf(": render.max_bounces: ReSTIR stores paths of at most %u vertices (got %d); "
+  checkGpuSupports(scene, "ReSTIR", true);
+  // A path of max_bounces scattering vertices, and with emission one more vertex that emits.
+  const int vertices = scene.render.maxBounces + (features_.emission ? 1 : 0);
+  if (vertices > int(shared::RS_MAX_VERTICES)) {
+    throw InputError(scene.path + strf(": render.max_bounces: ReSTIR stores paths of at most %u vertices (got %d%s); "
                                        "use mode pt for longer paths",
-                                       shared::RS_MAX_VERTICES, scene.render.maxBounces));
+                                       shared::RS_MAX_VERTICES, vertices,
+                                       features_.emission ? ": max_bounces + 1 for an emitting medium" : ""));
   }
   if (options_.neighbours > int(shared::RS_MAX_NEIGHBOURS)) {
     throw InputError(scene.path + strf(": render.restir_neighbours: at most %u", shared::RS_MAX_NEIGHBOURS));
   }
   using gpu::BindingType;
   // shaders/restir/bindings.glsl (numbers in shaders/shared/bindings.h)
-  const std::vector<BindingType> bindings = gpu::bindingTable(
-      shared::RS_BINDING_COUNT, {{shared::BIND_ATLAS, BindingType::SampledImage}, {shared::BIND_PREV_ATLAS, BindingType::SampledImage}});
+  // Every binding in a table must be written before a dispatch (lavapipe reads them all): the
+  // emission's exist only in the tables of an emitting scene.
+  const std::vector<BindingType> bindings =
+      features_.emission
+          ? gpu::bindingTable(shared::EMISSION_BINDING_COUNT,
+                              {{shared::BIND_ATLAS, BindingType::SampledImage}, {shared::BIND_PREV_ATLAS, BindingType::SampledImage},
+                               {shared::BIND_EMISSION_ATLAS, BindingType::SampledImage},
+                               {shared::BIND_PREV_EMISSION_ATLAS, BindingType::SampledImage}})
+          : gpu::bindingTable(shared::RS_BINDING_COUNT, {{shared::BIND_ATLAS, BindingType::SampledImage},
+                                                         {shared::BIND_PREV_ATLAS, BindingType::SampledImage}});
   const gpu::ShaderDefines defines = features_.defines();
   const std::string variant = " [" + features_.name() + "]";
   // Each pass is compiled with only the code its options use (MIS kind, temporal or spatial,
@@ -111,7 +122,7 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
 
   const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   const size_t pixels = size_t(scene.camera.width) * scene.camera.height;
-  const uint32_t stride = uint32_t(std::max(1, scene.render.maxBounces - 1));
+  const uint32_t stride = uint32_t(std::max(1, vertices - 1));
   frameBuffer_ = gpu::Buffer(ctx, sizeof(shared::GpuFrame), storage, "frame parameters");
   const std::vector<shared::GpuLight> lights = gpuLights(scene);
   lightBuffer_ = gpu::Buffer(ctx, lights.size() * sizeof(shared::GpuLight), storage, "lights");
