@@ -9,9 +9,11 @@
 //          * p_light,
 // and only "vertex j of some walk, light l" can produce it, so the M walks give it the MIS
 // weight 1/M (GRIS allows candidates of one walk to be dependent: only marginals matter). With an
-// emitting medium (PLUME_HAS_EMISSION) every vertex also ends a candidate with its own emission
-// (sigma_a Le at x_j, pdf without a light factor; light = RS_LIGHT_EMISSION), up to vertex
-// max_bounces + 1: both ends go through the one reservoir, so reuse shares good emitters too.
+// emitting medium (PLUME_HAS_EMISSION) every vertex from the second on also ends a candidate with
+// its own emission (sigma_a Le at x_j, pdf without a light factor; light = RS_LIGHT_EMISSION), up
+// to vertex max_bounces + 1: both ends go through the one reservoir, so reuse shares good
+// emitters too. Emission seen directly (a one-vertex path) is final shading's, by tracking along
+// the camera ray (restir/shade.glsl): every path is counted once.
 // The reservoir's confidence is M. Requires restir/bridge.glsl.
 #ifndef PLUME_RESTIR_CANDIDATES_GLSL
 #define PLUME_RESTIR_CANDIDATES_GLSL
@@ -65,7 +67,7 @@ void rs_generate_candidates(uvec2 pixel, uint pixelIndex, uint outSet) {
         walk[j - 2u] = vec4(w, t);
       }
 #ifdef PLUME_HAS_EMISSION
-      {  // the candidate ending with x_j's emission: sigma_a Le instead of scattering
+      if (j >= 2u) {  // the candidate ending with x_j's emission: sigma_a Le instead of scattering
         float ph = rs_luminance(fArrive * (vec3(1.0f) - vtx_albedo(VERTEX_MEDIUM)) * vol_emitted_radiance_world(VOL_CURRENT, x));
         if (rs_update(r, invM * ph / pdf, ph, 0.0f, rng_float(rng))) {
           head.lightSample = vec2(0.0f);

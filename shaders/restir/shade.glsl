@@ -1,7 +1,8 @@
 // Final shading (DESIGN §4.2 step 7): the selected path evaluated once with unbiased
 // transmittance (residual ratio tracking on the fine grid, every segment and the light ray) times
 // W = w_sum / p̂(Y); plus the radiance of the camera ray escaping the scene (light_escaped, also
-// by residual ratio tracking), which no reservoir path covers. Requires restir/bridge.glsl.
+// by residual ratio tracking) and the medium's emission seen directly, which no reservoir path
+// covers. Requires restir/bridge.glsl.
 #ifndef PLUME_RESTIR_SHADE_GLSL
 #define PLUME_RESTIR_SHADE_GLSL
 
@@ -16,6 +17,13 @@ vec3 rs_shade(uvec2 pixel, uint pixelIndex, uint set) {
 #ifdef PLUME_HAS_ENV
   vec3 dir = rs_domain_dir(D, rng_float2(rng));
   L += light_escaped(dir) * vol_residual_tr(D.origin, dir, DDA_INF, rng);
+#endif
+#ifdef PLUME_HAS_EMISSION
+  // The medium's emission seen directly (paths of one vertex, which no candidate ends with),
+  // gathered along a camera ray with ratio tracking's running transmittance (vol_emission_along:
+  // no collision is needed, so the whole ray counts). A self-lit fire is mostly this term; the
+  // reservoirs carry the light the fire and the lights scatter.
+  L += (vec3(1.0f) - vtx_albedo(VERTEX_MEDIUM)) * vol_emission_along(D.origin, rs_domain_dir(D, rng_float2(rng)), DDA_INF, rng);
 #endif
   return L;
 }

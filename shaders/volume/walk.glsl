@@ -126,6 +126,7 @@ const uint VOL_TRACK_RESIDUAL = 2u;  // residual ratio tracking against the mean
 const uint VOL_TRACK_TAU = 3u;       // the mean field's optical depth (deterministic)
 const uint VOL_TRACK_SAMPLE = 4u;    // a collision in the mean field, pdf in closed form
 const uint VOL_TRACK_DELTA_EMIT = 5u;  // delta tracking that also gathers the medium's emission
+const uint VOL_TRACK_RATIO_EMIT = 6u;  // the emission reaching the origin along a whole ray
 
 struct VolTrack {
   float value;  // RATIO, RESIDUAL: the transmittance estimate; TAU: the optical depth;
@@ -135,7 +136,8 @@ struct VolTrack {
   bool hit;     // DELTA, SAMPLE: a collision was found
   bool stop;    // the walk ends now (a hit, a transmittance ended by roulette, the step cap)
 #ifdef PLUME_HAS_EMISSION
-  vec3 emitted; // DELTA_EMIT: sum of sigma_t Le / mu over the tentative collisions up to the hit
+  vec3 emitted; // DELTA_EMIT: sum of sigma_t Le / mu over the tentative collisions up to the hit;
+                // RATIO_EMIT: sum of T sigma_t Le / mu over all of them, T by ratio tracking
 #endif
 };
 
@@ -159,7 +161,7 @@ bool vol_transmittance_roulette(inout float tr, inout RngState rng) {
 // Whether the walk goes on to the next segment.
 bool vol_track_alive(uint tracker, VolTrack s) {
   if (s.stop) return false;
-  if (tracker == VOL_TRACK_RATIO) return s.value > 0.0f;
+  if (tracker == VOL_TRACK_RATIO || tracker == VOL_TRACK_RATIO_EMIT) return s.value > 0.0f;
   if (tracker == VOL_TRACK_RESIDUAL) return s.value != 0.0f;
   if (tracker == VOL_TRACK_TAU) return s.value < VOL_MAX_TAU;
   return !s.hit;
@@ -168,7 +170,8 @@ bool vol_track_alive(uint tracker, VolTrack s) {
 // On entering segment [a, b) with field value `value`: returns the rate of the tentative
 // collisions the tracker wants there (0: none).
 float vol_track_segment(uint tracker, inout VolTrack s, float a, float b, vec2 value) {
-  if (tracker == VOL_TRACK_DELTA || tracker == VOL_TRACK_RATIO || tracker == VOL_TRACK_DELTA_EMIT) {
+  if (tracker == VOL_TRACK_DELTA || tracker == VOL_TRACK_RATIO || tracker == VOL_TRACK_DELTA_EMIT ||
+      tracker == VOL_TRACK_RATIO_EMIT) {
     return value.x;  // the majorant
   }
   if (tracker == VOL_TRACK_RESIDUAL) {
@@ -224,6 +227,18 @@ void vol_track_event(uint tracker, inout VolTrack s, uint v, float scale, vec3 p
       s.hit = true;
       s.stop = true;
     }
+  } else if (tracker == VOL_TRACK_RATIO_EMIT) {
+    // Every tentative collision adds T(t) sigma_t Le / mu with T(t) the ratio-tracking estimate up
+    // to it (unbiased for the transmittance there, and independent of the point's own weight), so
+    // the sum estimates the integral of T sigma_t Le over the whole ray without stopping at a
+    // collision: the expected-value form of DELTA_EMIT, for rays that need no collision.
+    float sigma = scale * vol_density(v, p);
+    s.emitted += (s.value * sigma / mu) * vol_emitted_radiance(v, p);
+    s.value *= max(0.0f, 1.0f - sigma / mu);
+    if (!vol_transmittance_roulette(s.value, rng)) {
+      s.value = 0.0f;
+      s.stop = true;
+    }
   }
 #endif
 }
@@ -241,7 +256,7 @@ VolTrack vol_track(uint tracker, uint v, vec3 xWorld, vec3 wWorld, float tMax, f
 #ifdef PLUME_HAS_EMISSION
   s.emitted = vec3(0.0f);
 #endif
-  uint field = (tracker <= VOL_TRACK_RATIO || tracker == VOL_TRACK_DELTA_EMIT) ? VOL_FIELD_MAJORANT : VOL_FIELD_MEAN;
+  uint field = (tracker <= VOL_TRACK_RATIO || tracker >= VOL_TRACK_DELTA_EMIT) ? VOL_FIELD_MAJORANT : VOL_FIELD_MEAN;
   vec3 o;
   vec3 d;
   vol_ray_to_index(v, xWorld, wWorld, o, d);
@@ -290,6 +305,15 @@ bool vol_sample_collision_emitting(vec3 oWorld, vec3 dWorld, float tMax, inout R
   tHit = s.t;
   emitted = s.emitted;
   return s.hit;
+}
+#endif
+
+#ifdef PLUME_HAS_EMISSION
+// The radiance the medium emits towards the ray's origin over (0, tMax), divided by the albedo's
+// complement (times 1 - albedo: an unbiased estimate of the integral of T sigma_a Le): ratio
+// tracking's running transmittance weighs every tentative collision (VOL_TRACK_RATIO_EMIT).
+vec3 vol_emission_along(vec3 oWorld, vec3 dWorld, float tMax, inout RngState rng) {
+  return vol_track(VOL_TRACK_RATIO_EMIT, VOL_CURRENT, oWorld, dWorld, tMax, 1.0f, rng).emitted;
 }
 #endif
 
