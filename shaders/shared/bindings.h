@@ -36,7 +36,11 @@ const uint BIND_RS_BOUNCES = 15u;      // vec4(w_i, t_i) of vertices 2..n
 const uint BIND_RS_OUTPUT = 16u;       // accumulation of final shading (as BIND_PT_ACCUM)
 const uint BIND_RS_COUNTERS = 17u;     // uint[]: [0] reservoirs dropped for non-finite weights
 const uint BIND_LIGHT_CHOICE = 18u;    // GpuLightChoice[]
-const uint RS_BINDING_COUNT = 19u;
+const uint RS_BINDING_COUNT = 20u;     // up to BIND_ENV_MAP
+
+// The scene's environment map, every estimator (shared/envmap.h: GpuEnvMap, then float data);
+// read only by variants compiled with PLUME_HAS_ENV_MAP, a 1-texel black map otherwise.
+const uint BIND_ENV_MAP = 19u;
 
 PLUME_NS_END
 

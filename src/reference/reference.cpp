@@ -3,6 +3,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/progress.h"
+#include "reference/environment.h"
 #include "reference/medium.h"
 #include "shaders/shared/phase.h"
 #include "shaders/shared/sampling.h"
@@ -14,6 +15,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <vector>
 
 namespace plume::ref {
@@ -31,6 +33,7 @@ struct PreparedLight {
   dvec3 irradiance{0};  // delta sun
   dvec3 position{0};    // point
   dvec3 intensity{0};   // point
+  std::shared_ptr<const ReferenceEnvironmentMap> map;  // environment with a map
 };
 
 struct Context {
@@ -41,6 +44,7 @@ struct Context {
   int maxBounces;
   int rrStartBounce;
   dvec3 environment{0};  // sum of constant environment radiance seen by escaping camera rays
+  const ReferenceEnvironmentMap* map = nullptr;  // and the map's (at most one)
   TrackingStats* tracking;
 };
 
@@ -48,7 +52,8 @@ dvec3 toD(glm::vec3 v) { return dvec3(v); }
 
 std::vector<PreparedLight> prepareLights(const Scene& scene) {
   std::vector<PreparedLight> out;
-  for (const Light& l : scene.lights) {
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    const Light& l = scene.lights[i];
     PreparedLight p;
     p.type = l.type;
     switch (l.type) {
@@ -70,6 +75,7 @@ std::vector<PreparedLight> prepareLights(const Scene& scene) {
         break;
       case LightType::Environment:
         p.radiance = toD(l.radiance) * double(l.scale);
+        if (!l.map.empty()) p.map = std::make_shared<ReferenceEnvironmentMap>(l, scene.path + strf(": lights[%zu].map", i));
         break;
     }
     out.push_back(p);
@@ -111,6 +117,17 @@ dvec3 estimateDirect(const Context& c, const dvec3& x, const dvec3& rayDir, Pcg3
         break;
       }
       case LightType::Environment: {
+        if (l.map) {
+          // Importance sample the map (its own distribution): weight = L * phase / pdf * T.
+          const double uTexel = (double(rng.uniform()) + double(rng.uniform()) / 16777216.0);
+          const double uPhi = rng.uniform(), uCos = rng.uniform();
+          double pdf;
+          const dvec3 w = l.map->sample(uTexel, uPhi, uCos, pdf);
+          if (!(pdf > 0)) break;
+          double tr = c.medium->ratioTracking({x, w}, inf, rng, acc, *c.tracking);
+          sum += l.map->radiance(w) * phase(glm::dot(w, rayDir), c.g) * tr / pdf;
+          break;
+        }
         // Importance sample the phase function: weight = L * phase / pdf * T = L * T.
         glm::vec2 u(rng.uniform(), rng.uniform());
         dvec3 w = dvec3(sh::ph_hg_sample(glm::vec3(rayDir), c.g, u));
@@ -133,6 +150,7 @@ dvec3 tracePath(const Context& c, Ray ray, Pcg32& rng, const ReferenceMedium::Ac
       // Escaped. Light sources are reached by next-event estimation after the first vertex,
       // so only camera rays add the environment seen directly.
       if (scatterings == 0) radiance += beta * c.environment;
+      if (scatterings == 0 && c.map) radiance += beta * c.map->radiance(ray.direction);
       break;
     }
     if (++scatterings > c.maxBounces) break;
@@ -185,11 +203,6 @@ void checkReferenceSupports(const Scene& scene) {
       throw InputError(scene.path + strf(": media[%zu].emission: not supported by the CPU reference yet", i));
     }
   }
-  for (size_t i = 0; i < scene.lights.size(); ++i) {
-    if (!scene.lights[i].map.empty()) {
-      throw InputError(scene.path + strf(": lights[%zu].map: environment maps are not supported by the CPU reference yet", i));
-    }
-  }
 }
 
 Image renderReference(const Scene& scene, openvdb::FloatGrid::ConstPtr density,
@@ -210,7 +223,8 @@ Image renderReference(const Scene& scene, openvdb::FloatGrid::ConstPtr density,
   ctx.rrStartBounce = rs.rrStartBounce;
   ctx.tracking = &tracking;
   for (const PreparedLight& l : ctx.lights) {
-    if (l.type == LightType::Environment) ctx.environment += l.radiance;
+    if (l.type == LightType::Environment && !l.map) ctx.environment += l.radiance;
+    if (l.map) ctx.map = l.map.get();
   }
 
   const CameraFrame frame = cameraFrame(cam, options.frame);

@@ -13,6 +13,7 @@ namespace plume {
 PathTracer::PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene)
     : ctx_(ctx), scene_(scene), features_(featuresOf(scene)), compiler_(compiler), timer_(ctx) {
   checkGpuSupports(scene, "the GPU path tracer");
+  envMap_ = std::make_unique<GpuEnvironmentMap>(ctx, scene);
   const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   const size_t pixels = size_t(scene.camera.width) * scene.camera.height;
   frameBuffer_ = gpu::Buffer(ctx, sizeof(shared::GpuFrame), storage, "frame parameters");
@@ -31,11 +32,12 @@ gpu::ComputePass& PathTracer::makePass(bool skipEmpty) {
   if (skipEmpty) defines.emplace_back("PLUME_SKIP_EMPTY", "1");
   pass = std::make_unique<gpu::ComputePass>(
       ctx_, compiler_.compile("passes/pt.comp", defines),
-      gpu::bindingTable(shared::BIND_PT_ACCUM + 1, {{shared::BIND_ATLAS, BindingType::SampledImage}}), 0,
+      gpu::bindingTable(shared::BIND_ENV_MAP + 1, {{shared::BIND_ATLAS, BindingType::SampledImage}}), 0,
       "path tracing [" + features_.name() + (skipEmpty ? "+skip" : "") + "]", glm::uvec3(8, 8, 1));
   pass->set.bind(shared::BIND_FRAME, frameBuffer_);
   pass->set.bind(shared::BIND_LIGHTS, lightBuffer_);
   pass->set.bind(shared::BIND_PT_ACCUM, accum_);
+  envMap_->bind(pass->set);
   return *pass;
 }
 
