@@ -63,7 +63,9 @@ PLUME_FN vec2 env_local_uv(vec3 d) {
   float u = atan(d.x, -d.z) * (0.5f * PLUME_INV_PI);
   if (u < 0.0f) u += 1.0f;
   if (u >= 1.0f) u = 0.0f;  // -0 + 1 rounds to 1
-  float v = acos(clamp(d.y, -1.0f, 1.0f)) * PLUME_INV_PI;
+  // acos(y) as atan2(|xz|, y): on lavapipe acos is off by up to ~6e-5 rad (0.005 of a texel
+  // of a 512 x 256 map), atan2 by far less.
+  float v = atan(sqrt(d.x * d.x + d.z * d.z), d.y) * PLUME_INV_PI;
   return vec2(u, v);
 }
 
