@@ -95,3 +95,36 @@ TEST(Scene, FramePatterns) {
   EXPECT_EQ(expandFramePattern("a_{frame}.vdb", 12), "a_12.vdb");
   EXPECT_FALSE(hasFramePattern("plain.vdb"));
 }
+
+// Environment maps (DESIGN §2, §9): the keys, `up` normalised, the map resolved against the
+// scene's folder; radiance with a map, a zero `up` and two maps are refused naming the key.
+TEST(Scene, EnvironmentMapKeys) {
+  json doc = minimalScene();
+  const std::string dir = PLUME_SOURCE_DIR "/volumes/smoke";
+  doc["lights"].push_back({{"type", "environment"}, {"map", "../sky/sky.exr"}, {"up", {0, 0, 2}},
+                           {"rotate_y_deg", -30}, {"scale", 2.5}});
+  Scene s = parseScene(doc, "scene.json", dir);
+  const Light& l = s.lights.at(1);
+  EXPECT_EQ(l.map, PLUME_SOURCE_DIR "/volumes/sky/sky.exr");
+  EXPECT_EQ(l.up, glm::vec3(0, 0, 1));
+  EXPECT_FLOAT_EQ(l.rotateYDeg, -30.0f);
+  EXPECT_FLOAT_EQ(l.scale, 2.5f);
+  EXPECT_EQ(s.lights.at(0).map, "");
+  auto errorIn = [&](const json& d) {
+    try {
+      parseScene(d, "scene.json", dir);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  json both = doc;
+  both["lights"][1]["radiance"] = {1, 1, 1};
+  EXPECT_NE(errorIn(both).find("scene.json: lights[1].map: give either"), std::string::npos) << errorIn(both);
+  json zeroUp = doc;
+  zeroUp["lights"][1]["up"] = {0, 0, 0};
+  EXPECT_NE(errorIn(zeroUp).find("lights[1].up: zero-length"), std::string::npos) << errorIn(zeroUp);
+  json two = doc;
+  two["lights"].push_back(doc["lights"][1]);
+  EXPECT_NE(errorIn(two).find("lights: at most one environment light may have a map"), std::string::npos) << errorIn(two);
+}

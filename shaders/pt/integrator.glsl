@@ -2,8 +2,14 @@
 // free flights, next-event estimation with ratio tracking to every light, phase sampling, Russian
 // roulette. `frame.spp` samples per pixel per dispatch, merged into a running mean and M2 per
 // pixel (Chan et al.'s parallel variance update) so progressive batches give the variance of the
-// mean. Variant defines: PLUME_HAS_SUN, PLUME_HAS_POINT, PLUME_HAS_ENV, PLUME_MULTI_BOUNCE,
-// PLUME_HAS_EMISSION (the medium's emission gathered along every segment by delta tracking).
+// mean. Variant defines: PLUME_HAS_SUN, PLUME_HAS_POINT, PLUME_HAS_ENV, PLUME_HAS_ENV_MAP,
+// PLUME_MULTI_BOUNCE, PLUME_HAS_EMISSION (the medium's emission gathered along every segment by
+// delta tracking).
+// An environment map is reached two ways, combined by the power heuristic (Veach's thesis, eq.
+// 9.15): next-event estimation draws a direction from the map (pdf p_l) and the path's next
+// phase-sampled direction (pdf p_ph), which adds the map's radiance where it escapes; weights
+// p_l² / (p_l² + p_ph²) and p_ph² / (p_l² + p_ph²). Every other light, a constant environment
+// included, is reached by next-event estimation alone (only camera rays see it directly).
 // Requires volume/bindings.glsl, scene/bindings.glsl and ptAccum (shaders/passes/pt.comp).
 #ifndef PLUME_PT_INTEGRATOR_GLSL
 #define PLUME_PT_INTEGRATOR_GLSL
@@ -25,16 +31,36 @@ vec3 pt_direct(uint kind, vec3 x, vec3 rayDir, inout RngState rng) {
     float dist;
     vec3 Le;
     if (!light_connect(l, x, light_sample_dir(l, x, rayDir, frame.g, u), w, dist, Le)) continue;
+    float pdf = light_pdf(l, w, rayDir, frame.g);
+    if (!(pdf > 0.0f)) continue;  // (an all-black map)
+    float scatter = vtx_scatter(kind, rayDir, w);
+    float mis = 1.0f;
+#ifdef PLUME_HAS_ENV_MAP
+    if (l.type == LIGHT_ENV_MAP) mis = pdf * pdf / (pdf * pdf + scatter * scatter);  // p_ph = phase
+#endif
     float tr = vol_ratio_tracking(x, w, dist, rng);
-    sum += Le * vtx_scatter(kind, rayDir, w) * tr / light_pdf(l, w, rayDir, frame.g);
+    sum += Le * scatter * tr * (mis / pdf);
   }
   return sum;
 }
 
+#ifdef PLUME_HAS_ENV_MAP
+// The environment map seen by a path that escapes along dir after a vertex that drew dir by
+// phase sampling with pdf phasePdf: its power-heuristic weight against the map's NEE.
+vec3 pt_escaped_map(vec3 dir, float phasePdf) {
+  float pl = env_pdf(envMap, dir);
+  return env_radiance(envMap, dir) * (phasePdf * phasePdf / (phasePdf * phasePdf + pl * pl));
+}
+#endif
+
 vec3 pt_trace_path(vec3 origin, vec3 dir, inout RngState rng) {
   vec3 radiance = vec3(0.0f);
   vec3 beta = vec3(1.0f);
-#ifdef PLUME_MULTI_BOUNCE
+  float phasePdf = 0.0f;  // pdf of dir where a vertex drew it (the map's MIS)
+  // With a map, a single-scattering path still follows its phase-sampled direction after its
+  // vertex, to see whether it escapes (the map's MIS), so the loop runs.
+#if defined(PLUME_MULTI_BOUNCE) || defined(PLUME_HAS_ENV_MAP)
+#define PT_FOLLOWS_PHASE 1
   for (uint scatterings = 0u;;) {
 #else
   {
@@ -51,21 +77,27 @@ vec3 pt_trace_path(vec3 origin, vec3 dir, inout RngState rng) {
 #else
     if (!vol_sample_collision(origin, dir, DDA_INF, rng, t)) {
 #endif
-      // Lights are reached by NEE after the first vertex: only camera rays see the environment.
+      // Camera rays see every environment; after a vertex, only a map is seen (with its MIS
+      // weight): the other lights are reached by NEE.
       if (scatterings == 0u) radiance += beta * light_escaped(dir);
+#ifdef PLUME_HAS_ENV_MAP
+      else radiance += beta * pt_escaped_map(dir, phasePdf);
+#endif
       return radiance;
     }
     if (++scatterings > frame.maxBounces) return radiance;
     vec3 x = origin + t * dir;
     beta *= vtx_albedo(VERTEX_MEDIUM);  // delta tracking's collision weight
     radiance += beta * pt_direct(VERTEX_MEDIUM, x, dir, rng);
-#ifdef PLUME_MULTI_BOUNCE
+#ifdef PT_FOLLOWS_PHASE
     if (scatterings >= frame.rrStartBounce) {
       float q = min(1.0f, plume_max3(beta));
       if (rng_float(rng) >= q) return radiance;
       beta /= q;
     }
-    dir = normalize(vtx_sample(VERTEX_MEDIUM, dir, rng_float2(rng)));
+    vec3 next = normalize(vtx_sample(VERTEX_MEDIUM, dir, rng_float2(rng)));
+    phasePdf = vtx_scatter(VERTEX_MEDIUM, dir, next);  // a medium vertex samples its phase exactly
+    dir = next;
     origin = x;
 #endif
   }

@@ -36,13 +36,17 @@ const uint BIND_RS_BOUNCES = 15u;      // vec4(w_i, t_i) of vertices 2..n
 const uint BIND_RS_OUTPUT = 16u;       // accumulation of final shading (as BIND_PT_ACCUM)
 const uint BIND_RS_COUNTERS = 17u;     // uint[]: [0] reservoirs dropped for non-finite weights
 const uint BIND_LIGHT_CHOICE = 18u;    // GpuLightChoice[]
-const uint RS_BINDING_COUNT = 19u;
+const uint RS_BINDING_COUNT = 20u;     // up to BIND_ENV_MAP
+
+// The scene's environment map, every estimator (shared/envmap.h: GpuEnvMap, then float data);
+// read only by variants compiled with PLUME_HAS_ENV_MAP, a 1-texel black map otherwise.
+const uint BIND_ENV_MAP = 19u;
 
 // A medium's emission (shaders/volume/bindings.glsl with PLUME_HAS_EMISSION), every estimator.
-const uint BIND_EMISSION_ATLAS = 19u;  // sampler3D: the emission grid in the atlas layout, R32F
-const uint BIND_BLACKBODY = 20u;       // vec4[]: the blackbody table (shared/blackbody.h)
-const uint BIND_PREV_EMISSION_ATLAS = 21u;  // sampler3D: the previous frame's (ReSTIR's history)
-const uint EMISSION_BINDING_COUNT = 22u;  // binding tables that may hold the emission extend to it
+const uint BIND_EMISSION_ATLAS = 20u;  // sampler3D: the emission grid in the atlas layout, R32F
+const uint BIND_BLACKBODY = 21u;       // vec4[]: the blackbody table (shared/blackbody.h)
+const uint BIND_PREV_EMISSION_ATLAS = 22u;  // sampler3D: the previous frame's (ReSTIR's history)
+const uint EMISSION_BINDING_COUNT = 23u;  // binding tables that may hold the emission extend to it
 
 PLUME_NS_END
 

@@ -50,13 +50,27 @@ const uint EMISSION_BLACKBODY = 2u;  // Le = emissionScale * B(temperatureScale 
 const uint LIGHT_SUN = 0u;
 const uint LIGHT_POINT = 1u;
 const uint LIGHT_ENVIRONMENT = 2u;
+const uint LIGHT_ENV_MAP = 3u;  // an environment with a map (shared/envmap.h), at most one
 
 // A light (scene/scene.h Light), ready for sampling (shaders/light/light.glsl).
 struct GpuLight {
-  vec3 dirOrPos;    // sun: unit direction towards the sun; point: position; environment: unused
+  vec3 dirOrPos;    // sun: unit direction towards the sun; point: position; environments: unused
   uint type;        // LIGHT_*
-  vec3 emission;    // sun: irradiance (delta) or radiance (disk); point: intensity; environment: radiance
+  vec3 emission;    // sun: irradiance (delta) or radiance (disk); point: intensity; environment: radiance;
+                    // env map: unused (the texels hold radiance times scale)
   float versine;    // sun: the disk's 1 - cos(angular radius), 0 for a delta direction
+};
+
+// The environment map's header (shared/envmap.h): the world-to-local rotation's rows
+// (R = R_y(-rotate_y_deg) M, DESIGN §2) and the size; the texels and CDFs follow it as float[].
+struct GpuEnvMap {
+  vec4 toLocal0;  // xyz: row 0 of R (w unused)
+  vec4 toLocal1;
+  vec4 toLocal2;
+  uint width;
+  uint height;
+  uint pad0;
+  uint pad1;
 };
 
 // How an estimator that picks one light per sample chooses it (ReSTIR's candidates): its
@@ -117,6 +131,8 @@ static_assert(sizeof(plume::shared::GpuVolume) == 2 * 64 + 5 * 16 + 4 * 16 + 16 
 static_assert(sizeof(plume::shared::GpuLight) == 32, "GpuLight layout");
 static_assert(offsetof(plume::shared::GpuLight, emission) == 16, "GpuLight layout");
 static_assert(sizeof(plume::shared::GpuLightChoice) == 8, "GpuLightChoice layout");
+static_assert(sizeof(plume::shared::GpuEnvMap) == 64, "GpuEnvMap layout");
+static_assert(offsetof(plume::shared::GpuEnvMap, width) == 48, "GpuEnvMap layout");
 static_assert(sizeof(plume::shared::GpuCamera) == 64, "GpuCamera layout");
 static_assert(offsetof(plume::shared::GpuFrame, albedo) == 64, "GpuFrame layout");
 static_assert(offsetof(plume::shared::GpuFrame, size) == 80, "GpuFrame layout");

@@ -5,6 +5,7 @@
 #include "core/progress.h"
 #include "media/vdb_loader.h"
 #include "reference/emission.h"
+#include "reference/environment.h"
 #include "reference/medium.h"
 #include "shaders/shared/phase.h"
 #include "shaders/shared/sampling.h"
@@ -15,9 +16,9 @@
 #include <tbb/parallel_for.h>
 
 #include <chrono>
+#include <cmath>
 #include <memory>
 #include <optional>
-#include <cmath>
 #include <vector>
 
 namespace plume::ref {
@@ -35,6 +36,7 @@ struct PreparedLight {
   dvec3 irradiance{0};  // delta sun
   dvec3 position{0};    // point
   dvec3 intensity{0};   // point
+  std::shared_ptr<const ReferenceEnvironmentMap> map;  // environment with a map
 };
 
 struct Context {
@@ -45,6 +47,7 @@ struct Context {
   int maxBounces;
   int rrStartBounce;
   dvec3 environment{0};  // sum of constant environment radiance seen by escaping camera rays
+  const ReferenceEnvironmentMap* map = nullptr;  // and the map's (at most one)
   const ReferenceEmission* emission = nullptr;  // the medium emits
   TrackingStats* tracking;
 };
@@ -53,7 +56,8 @@ dvec3 toD(glm::vec3 v) { return dvec3(v); }
 
 std::vector<PreparedLight> prepareLights(const Scene& scene) {
   std::vector<PreparedLight> out;
-  for (const Light& l : scene.lights) {
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    const Light& l = scene.lights[i];
     PreparedLight p;
     p.type = l.type;
     switch (l.type) {
@@ -75,6 +79,7 @@ std::vector<PreparedLight> prepareLights(const Scene& scene) {
         break;
       case LightType::Environment:
         p.radiance = toD(l.radiance) * double(l.scale);
+        if (!l.map.empty()) p.map = std::make_shared<ReferenceEnvironmentMap>(l, scene.path + strf(": lights[%zu].map", i));
         break;
     }
     out.push_back(p);
@@ -116,6 +121,17 @@ dvec3 estimateDirect(const Context& c, const dvec3& x, const dvec3& rayDir, Pcg3
         break;
       }
       case LightType::Environment: {
+        if (l.map) {
+          // Importance sample the map (its own distribution): weight = L * phase / pdf * T.
+          const double uTexel = (double(rng.uniform()) + double(rng.uniform()) / 16777216.0);
+          const double uPhi = rng.uniform(), uCos = rng.uniform();
+          double pdf;
+          const dvec3 w = l.map->sample(uTexel, uPhi, uCos, pdf);
+          if (!(pdf > 0)) break;
+          double tr = c.medium->ratioTracking({x, w}, inf, rng, acc, *c.tracking);
+          sum += l.map->radiance(w) * phase(glm::dot(w, rayDir), c.g) * tr / pdf;
+          break;
+        }
         // Importance sample the phase function: weight = L * phase / pdf * T = L * T.
         glm::vec2 u(rng.uniform(), rng.uniform());
         dvec3 w = dvec3(sh::ph_hg_sample(glm::vec3(rayDir), c.g, u));
@@ -128,7 +144,7 @@ dvec3 estimateDirect(const Context& c, const dvec3& x, const dvec3& rayDir, Pcg3
   return sum;
 }
 
-// One camera path. Surfaces and environment maps are refused earlier (checkReferenceSupports).
+// One camera path. Surfaces are refused earlier (checkReferenceSupports).
 dvec3 tracePath(const Context& c, Ray ray, Pcg32& rng, const ReferenceMedium::Accessor& acc,
                 const ReferenceEmission::Accessor* emissionAcc) {
   dvec3 radiance(0), beta(1);
@@ -152,6 +168,7 @@ dvec3 tracePath(const Context& c, Ray ray, Pcg32& rng, const ReferenceMedium::Ac
       // Escaped. Light sources are reached by next-event estimation after the first vertex,
       // so only camera rays add the environment seen directly.
       if (scatterings == 0) radiance += beta * c.environment;
+      if (scatterings == 0 && c.map) radiance += beta * c.map->radiance(ray.direction);
       break;
     }
     if (++scatterings > c.maxBounces) break;
@@ -199,11 +216,6 @@ void checkReferenceSupports(const Scene& scene) {
   if (!scene.surfaces.empty()) {
     throw InputError(scene.path + ": surfaces: not supported by the CPU reference yet");
   }
-  for (size_t i = 0; i < scene.lights.size(); ++i) {
-    if (!scene.lights[i].map.empty()) {
-      throw InputError(scene.path + strf(": lights[%zu].map: environment maps are not supported by the CPU reference yet", i));
-    }
-  }
 }
 
 Image renderReference(const Scene& scene, openvdb::FloatGrid::ConstPtr density,
@@ -224,7 +236,8 @@ Image renderReference(const Scene& scene, openvdb::FloatGrid::ConstPtr density,
   ctx.rrStartBounce = rs.rrStartBounce;
   ctx.tracking = &tracking;
   for (const PreparedLight& l : ctx.lights) {
-    if (l.type == LightType::Environment) ctx.environment += l.radiance;
+    if (l.type == LightType::Environment && !l.map) ctx.environment += l.radiance;
+    if (l.map) ctx.map = l.map.get();
   }
   std::unique_ptr<ReferenceEmission> emission;
   if (m.emission) {

@@ -32,8 +32,8 @@ struct ReferenceStats {
   double samplesPerSecond() const { return seconds > 0 ? samples / seconds : 0; }
 };
 
-// Throws InputError for scene features the reference does not support yet (surfaces,
-// environment maps), naming the scene key.
+// Throws InputError for scene features the reference does not support yet (surfaces), naming the
+// scene key.
 void checkReferenceSupports(const Scene& scene);
 
 // Renders `scene` at `options.frame` with the medium's density grid `density` (already loaded

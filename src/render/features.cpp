@@ -7,6 +7,7 @@ gpu::ShaderDefines FeatureSet::defines() const {
   if (sun) d.emplace_back("PLUME_HAS_SUN", "1");
   if (point) d.emplace_back("PLUME_HAS_POINT", "1");
   if (environment) d.emplace_back("PLUME_HAS_ENV", "1");
+  if (envMap) d.emplace_back("PLUME_HAS_ENV_MAP", "1");
   if (multiBounce) d.emplace_back("PLUME_MULTI_BOUNCE", "1");
   if (emission) d.emplace_back("PLUME_HAS_EMISSION", "1");
   if (blackbody) d.emplace_back("PLUME_EMISSION_BLACKBODY", "1");
@@ -23,6 +24,7 @@ std::string FeatureSet::name() const {
   add(sun, "sun");
   add(point, "point");
   add(environment, "env");
+  add(envMap, "envmap");
   add(multiBounce, "multi");
   add(emission, blackbody ? "blackbody" : "emission");
   return n.empty() ? "none" : n;
@@ -34,6 +36,7 @@ FeatureSet featuresOf(const Scene& scene) {
     f.sun |= l.type == LightType::Sun;
     f.point |= l.type == LightType::Point;
     f.environment |= l.type == LightType::Environment;
+    f.envMap |= l.type == LightType::Environment && !l.map.empty();
   }
   for (const Medium& m : scene.media) {
     f.emission |= m.emission.has_value();

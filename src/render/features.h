@@ -14,10 +14,11 @@ namespace plume {
 // What a scene needs compiled in (DESIGN §5): light types present, multiple bounces.
 // (Whether tracking skips empty space is a property of the volume: see PathTracer::setVolume.)
 struct FeatureSet {
-  bool sun = false, point = false, environment = false, multiBounce = false;
+  // environment: any environment light (a constant one or a map); envMap: one with a map.
+  bool sun = false, point = false, environment = false, envMap = false, multiBounce = false;
   bool emission = false, blackbody = false;  // the medium emits (blackbody: its colour form)
   gpu::ShaderDefines defines() const;
-  std::string name() const;  // e.g. "sun+env+multi"
+  std::string name() const;  // e.g. "sun+env+multi", "env+envmap"
 };
 FeatureSet featuresOf(const Scene& scene);
 

@@ -9,17 +9,8 @@
 
 namespace plume {
 
-void checkGpuSupports(const Scene& scene, const std::string& renderer, bool emission) {
+void checkGpuSupports(const Scene& scene, const std::string& renderer) {
   if (!scene.surfaces.empty()) throw InputError(scene.path + ": surfaces: not supported by " + renderer + " yet");
-  for (size_t i = 0; i < scene.media.size(); ++i) {
-    if (scene.media[i].emission && !emission) {
-      throw InputError(scene.path + strf(": media[%zu].emission: not supported by ", i) + renderer +
-                       " yet (render it with --mode pt)");
-    }
-  }
-  for (size_t i = 0; i < scene.lights.size(); ++i) {
-    if (!scene.lights[i].map.empty()) throw InputError(scene.path + strf(": lights[%zu].map: not supported yet", i));
-  }
 }
 
 std::vector<shared::GpuLight> gpuLights(const Scene& scene) {
@@ -47,8 +38,8 @@ std::vector<shared::GpuLight> gpuLights(const Scene& scene) {
         g.emission = l.intensity;
         break;
       case LightType::Environment:
-        g.type = shared::LIGHT_ENVIRONMENT;
-        g.emission = l.radiance * l.scale;
+        g.type = l.map.empty() ? shared::LIGHT_ENVIRONMENT : shared::LIGHT_ENV_MAP;
+        g.emission = l.map.empty() ? l.radiance * l.scale : glm::vec3(0.0f);  // a map's texels hold L * scale
         break;
     }
     out.push_back(g);

@@ -12,7 +12,8 @@ namespace plume {
 
 PathTracer::PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene)
     : ctx_(ctx), scene_(scene), features_(featuresOf(scene)), compiler_(compiler), timer_(ctx) {
-  checkGpuSupports(scene, "the GPU path tracer", true);
+  checkGpuSupports(scene, "the GPU path tracer");
+  envMap_ = std::make_unique<GpuEnvironmentMap>(ctx, scene);
   const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   const size_t pixels = size_t(scene.camera.width) * scene.camera.height;
   frameBuffer_ = gpu::Buffer(ctx, sizeof(shared::GpuFrame), storage, "frame parameters");
@@ -36,12 +37,13 @@ gpu::ComputePass& PathTracer::makePass(bool skipEmpty) {
       features_.emission
           ? gpu::bindingTable(shared::BIND_BLACKBODY + 1, {{shared::BIND_ATLAS, BindingType::SampledImage},
                                                             {shared::BIND_EMISSION_ATLAS, BindingType::SampledImage}})
-          : gpu::bindingTable(shared::BIND_PT_ACCUM + 1, {{shared::BIND_ATLAS, BindingType::SampledImage}}),
+          : gpu::bindingTable(shared::BIND_ENV_MAP + 1, {{shared::BIND_ATLAS, BindingType::SampledImage}}),
       0,
       "path tracing [" + features_.name() + (skipEmpty ? "+skip" : "") + "]", glm::uvec3(8, 8, 1));
   pass->set.bind(shared::BIND_FRAME, frameBuffer_);
   pass->set.bind(shared::BIND_LIGHTS, lightBuffer_);
   pass->set.bind(shared::BIND_PT_ACCUM, accum_);
+  envMap_->bind(pass->set);
   return *pass;
 }
 

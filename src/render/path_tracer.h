@@ -7,6 +7,7 @@
 #include "gpu/shader_compiler.h"
 #include "io/image.h"
 #include "render/features.h"
+#include "render/gpu_envmap.h"
 #include "render/gpu_volume.h"
 #include "scene/scene.h"
 
@@ -40,6 +41,7 @@ class PathTracer {
   gpu::Context& ctx_;
   const Scene& scene_;
   FeatureSet features_;
+  std::unique_ptr<GpuEnvironmentMap> envMap_;
   gpu::ComputePass& makePass(bool skipEmpty);
 
   gpu::ShaderCompiler& compiler_;

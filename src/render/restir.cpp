@@ -38,7 +38,8 @@ namespace {
 // (bundled smoke at 128², r2: 4.85x -> 5.26x static, 3.79x -> 3.70x moving with one light by
 // power; Blender smoke: 3.53x -> 5.19x and 2.72x -> 3.48x: the sky's light rays through dense
 // smoke carry almost nothing).
-std::vector<shared::GpuLightChoice> lightChoice(const Scene& scene, glm::vec3 centre) {
+// envMapMean: an environment map's mean radiance over the sphere (GpuEnvironmentMap).
+std::vector<shared::GpuLightChoice> lightChoice(const Scene& scene, glm::vec3 centre, glm::vec3 envMapMean) {
   const size_t n = scene.lights.size();
   std::vector<shared::GpuLightChoice> choice(std::max<size_t>(n, 1), shared::GpuLightChoice{});
   if (n == 0) return choice;
@@ -54,7 +55,7 @@ std::vector<shared::GpuLightChoice> lightChoice(const Scene& scene, glm::vec3 ce
         power[i] = lum(l.intensity) / (4.0 * M_PI * r2);
         break;
       }
-      case LightType::Environment: power[i] = lum(l.radiance * l.scale); break;
+      case LightType::Environment: power[i] = l.map.empty() ? lum(l.radiance * l.scale) : lum(envMapMean); break;
     }
     total += power[i];
   }
@@ -74,7 +75,8 @@ constexpr uint32_t kSets = 3;  // candidates / temporal / spatial rotate through
 
 Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene, const RestirOptions& options)
     : ctx_(ctx), scene_(scene), options_(options), features_(featuresOf(scene)), timer_(ctx, 32) {
-  checkGpuSupports(scene, "ReSTIR", true);
+  checkGpuSupports(scene, "ReSTIR");
+  envMap_ = std::make_unique<GpuEnvironmentMap>(ctx, scene);  // bad maps fail before compiling
   // A path of max_bounces scattering vertices, and with emission one more vertex that emits.
   const int vertices = scene.render.maxBounces + (features_.emission ? 1 : 0);
   if (vertices > int(shared::RS_MAX_VERTICES)) {
@@ -141,6 +143,7 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
     p->set.bind(shared::BIND_FRAME, frameBuffer_);
     p->set.bind(shared::BIND_LIGHTS, lightBuffer_);
     p->set.bind(shared::BIND_LIGHT_CHOICE, lightChoice_);
+    envMap_->bind(p->set);
     p->set.bind(shared::BIND_RS_PARAMS, paramBuffer_);
     p->set.bind(shared::BIND_RS_RESERVOIRS, reservoirs_);
     p->set.bind(shared::BIND_RS_PATHS, paths_);
@@ -172,7 +175,7 @@ void Restir::setVolumes(const GpuVolumeResources& current, const GpuVolumeResour
   centre_ = centre;
   currentSerial_ = current.serial();
   previousSerial_ = previous.serial();
-  const std::vector<shared::GpuLightChoice> choice = lightChoice(scene_, centre);
+  const std::vector<shared::GpuLightChoice> choice = lightChoice(scene_, centre, envMap_->meanRadiance());
   lightChoice_.upload(choice.data(), choice.size() * sizeof(shared::GpuLightChoice));
 }
 

@@ -12,6 +12,7 @@
 #include "gpu/pipeline.h"
 #include "gpu/shader_compiler.h"
 #include "io/image.h"
+#include "render/gpu_envmap.h"
 #include "render/gpu_volume.h"
 #include "render/path_tracer.h"
 #include "scene/scene.h"
@@ -74,6 +75,7 @@ class Restir {
   const Scene& scene_;
   RestirOptions options_;
   FeatureSet features_;
+  std::unique_ptr<GpuEnvironmentMap> envMap_;
   std::unique_ptr<gpu::ComputePass> candidates_, temporal_, spatial_, shade_;
   gpu::GpuTimer timer_;
   gpu::Buffer frameBuffer_, lightBuffer_, lightChoice_, paramBuffer_, reservoirs_, paths_, bounces_, output_, counters_;

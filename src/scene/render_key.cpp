@@ -69,7 +69,7 @@ std::string lightText(const Scene& scene, const Light& l) {
     case LightType::Point: return "point position " + vec(l.position) + ", intensity " + vec(l.intensity);
     case LightType::Environment:
       return "environment radiance " + vec(l.radiance) + ", scale " + num(l.scale) + ", map " +
-             (l.map.empty() ? "none" : sceneRelative(scene, l.map)) + ", rotate_y " + num(l.rotateYDeg);
+             (l.map.empty() ? "none" : sceneRelative(scene, l.map)) + ", up " + vec(l.up) + ", rotate_y " + num(l.rotateYDeg);
   }
   return "?";
 }

@@ -217,12 +217,18 @@ Light parseLight(const json& j, const std::string& file, const std::string& dir,
     l.intensity = r.vec3("intensity", l.intensity, 0.0, kInf, ">= 0");
   } else if (t == "environment") {
     l.type = LightType::Environment;
+    const bool hasRadiance = r.get("radiance") != nullptr;
     l.radiance = r.vec3("radiance", glm::vec3(0), 0.0, kInf, ">= 0");
     if (const json* map = r.get("map")) {
       if (!map->is_string() || map->get<std::string>().empty()) r.fail(kp + ".map", "expected a file path");
+      // One source of radiance per light: a map is not tinted by `radiance` (use `scale`).
+      if (hasRadiance) r.fail(kp + ".map", "give either \"radiance\" or \"map\", not both");
       l.map = resolvePath(dir, map->get<std::string>());
       if (!fs::exists(l.map)) r.fail(kp + ".map", "file not found: " + l.map);
     }
+    glm::vec3 up = r.vec3("up", l.up, -kInf, kInf, "");
+    if (glm::length(up) < 1e-12f) r.fail(kp + ".up", "zero-length direction");
+    l.up = glm::normalize(up);
     l.rotateYDeg = float(r.number("rotate_y_deg", 0.0, -kInf, kInf, ""));
     l.scale = float(r.number("scale", 1.0, 0.0, kInf, ">= 0"));
   } else {
@@ -307,6 +313,9 @@ Scene parseScene(const json& doc, const std::string& path, const std::string& di
   if (const json* lights = root.get("lights")) {
     if (!lights->is_array()) root.fail("lights", "expected an array of lights");
     for (size_t i = 0; i < lights->size(); ++i) scene.lights.push_back(parseLight((*lights)[i], path, dir, i));
+    if (std::count_if(scene.lights.begin(), scene.lights.end(), [](const Light& l) { return !l.map.empty(); }) > 1) {
+      root.fail("lights", "at most one environment light may have a map");
+    }
   }
   if (const json* surfaces = root.get("surfaces")) {
     if (!surfaces->is_array()) root.fail("surfaces", "expected an array of surfaces");

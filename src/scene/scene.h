@@ -78,7 +78,8 @@ struct Light {
   glm::vec3 intensity{0};           // W/sr
   // environment
   glm::vec3 radiance{0};            // constant radiance (multiplied by `scale`)
-  std::string map;                  // optional equirectangular EXR (resolved path)
+  std::string map;                  // or a lat-long EXR (resolved path), never both (DESIGN §2)
+  glm::vec3 up{0, 1, 0};            // the map's +Y in world space (normalised on load)
   float rotateYDeg = 0.0f;
   float scale = 1.0f;
 };

@@ -40,6 +40,18 @@ layout(std430, binding = 2) readonly buffer Params {
   GpuLightChoice choice[GPU_MAX_LIGHTS];
   RestirParams rsParams;
 };
+// envmap.h reads the global envData[] after its GpuEnvMap header (scene/bindings.glsl).
+layout(std430, binding = 3) readonly buffer EnvMapBuffer {
+  GpuEnvMap envMap;
+  float envData[];
+};
+#include "shared/envmap.h"
+// blackbody.h reads its table through BB_TABLE(i) (grid.glsl: the blackbody buffer).
+layout(std430, binding = 4) readonly buffer BlackbodyBuffer {
+  vec4 bbTable[];
+};
+#define BB_TABLE(i) bbTable[i].rgb
+#include "shared/blackbody.h"
 
 void main() {
   uint i = gl_GlobalInvocationID.x;
@@ -98,6 +110,17 @@ void main() {
   for (uint k = 0u; k < 3u; ++k) misM[k] = 1.0f + float(k);
   mis += rs_mis_weight(RS_MIS_PAIRWISE, 1u, 3u, 6.0f, pc) + rs_mis_weight(RS_MIS_GBH, 0u, 3u, 6.0f, pc);
   s += wd * mis;
+  // envmap.h
+  vec3 we = env_sample(envMap, u);
+  uvec2 tx = env_texel(envMap, env_local_uv(env_to_local(envMap, we)));
+  s += env_radiance(envMap, we) * (env_pdf(envMap, we) + env_texel_probability(envMap, tx) +
+                                   env_luminance(env_uv_local(u)) + float(env_data_size(2u, 1u)) +
+                                   float(env_find_interval(env_marginal_offset(envMap), envMap.height, u.x)) +
+                                   float(env_conditional_offset(envMap, 0u)) + float(BIND_ENV_MAP)) +
+       env_to_world(envMap, we);
+  // blackbody.h
+  s += bb_lookup(1000.0f + 9000.0f * u.x) * bb_table_kelvin(i % BB_TABLE_SIZE) * BB_TABLE_MAX_K * BB_TABLE_MIN_K +
+       vec3(float(BIND_BLACKBODY + BIND_EMISSION_ATLAS + BIND_PREV_EMISSION_ATLAS + EMISSION_BINDING_COUNT));
   values[i] = vec4(s + wo, t + m + (picked ? 1.0f : 0.0f) + (dropped ? 2.0f : 0.0f) +
                    (rs_is_finite(back.W) ? back.W : 0.0f));
 }

@@ -1,6 +1,10 @@
-// `plume-volgen badinputs`: broken VDB files for tests/bad_inputs (see cases.json there). Each is
+// `plume-volgen badinputs`: broken VDB and EXR files for tests/bad_inputs (see cases.json there). Each is
 // tiny and made deterministically; the scene files and the manifest are written by hand.
 #include "volgen.h"
+
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfOutputFile.h>
 
 #include <cstdio>
 #include <filesystem>
@@ -54,8 +58,20 @@ int runBadInputs(const std::string& outDir) {
   // A non-zero background (refused: outside the active voxels would be an infinite fog).
   writeVdb(out("nonzero_background.vdb"), {smallGrid("density", 0.5f)});
 
+  // Environment maps: not 2:1 (8 x 8), not an EXR, and a header that claims 32768 x 16384
+  // texels (more than any device's storage buffer range allows at 20 bytes per texel, 2^32
+  // bytes) with no pixels written: the size is refused from the header alone.
+  writeSkyExr(out("env_square.exr"), 8, 8, std::vector<float>(8 * 8 * 3, 0.5f));
+  writeBytes(out("env_garbage.exr"), garbage);
+  {
+    Imf::Header header(32768, 16384);
+    header.compression() = Imf::ZIP_COMPRESSION;
+    for (const char* c : {"R", "G", "B"}) header.channels().insert(c, Imf::Channel(Imf::HALF));
+    Imf::OutputFile huge(out("env_huge.exr").c_str(), header);
+  }
+
   for (const char* name : {"garbage.vdb", "empty.vdb", "truncated.vdb", "vec3_density.vdb", "no_density_grid.vdb",
-                           "frustum.vdb", "nonzero_background.vdb"}) {
+                           "frustum.vdb", "nonzero_background.vdb", "env_square.exr", "env_garbage.exr", "env_huge.exr"}) {
     std::printf("%s: %llu bytes\n", out(name).c_str(), (unsigned long long)fs::file_size(out(name)));
   }
   return 0;

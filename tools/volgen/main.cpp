@@ -2,6 +2,7 @@
 //   plume-volgen smoke --out volumes/smoke --frames 24 --res 64
 //   plume-volgen fire --out volumes/fire --frames 24 --res 64
 //   plume-volgen procedural --out volumes/procedural
+//   plume-volgen sky --out volumes/sky/sky.exr
 //   plume-volgen badinputs --out tests/bad_inputs
 //   plume-volgen preview FILE.vdb -o FILE.pgm
 #include "volgen.h"
@@ -49,6 +50,15 @@ int main(int argc, char** argv) {
   auto* pr = app.add_subcommand("procedural", "sphere, cloud, slab and ramp test grids");
   pr->add_option("--out", procOut, "output folder")->capture_default_str();
   pr->callback([&] { action = [&] { return runProcedural(procOut); }; });
+
+  SkyParams sky;
+  auto* sk = app.add_subcommand("sky", "analytic HDR sky with a sun disk, lat-long EXR (DESIGN §2)");
+  sk->add_option("--out", sky.out, "output .exr")->capture_default_str();
+  sk->add_option("--height", sky.height, "rows (the map is twice as wide)")->capture_default_str();
+  sk->add_option("--sun-dir", sky.sunDir, "direction towards the sun (world, y up)")->expected(3);
+  sk->add_option("--sun-radius", sky.sunRadiusDeg, "angular radius of the sun disk, degrees")->capture_default_str();
+  sk->add_option("--sun-irradiance", sky.sunIrradiance, "irradiance of the sun disk")->capture_default_str();
+  sk->callback([&] { action = [&] { return runSky(sky); }; });
 
   std::string badOut = "tests/bad_inputs";
   auto* bi = app.add_subcommand("badinputs", "broken VDB files for tests/bad_inputs");

@@ -6,6 +6,7 @@
 
 #include <openvdb/openvdb.h>
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -58,6 +59,23 @@ struct SmokeParams {
 int runSmoke(const SmokeParams& p);
 // The defaults of `plume-volgen fire` (volumes/README.md).
 SmokeParams fireDefaults();
+
+// An analytic HDR sky with a sun disk as a lat-long EXR (sky.cpp documents the model).
+struct SkyParams {
+  std::string out = "volumes/sky/sky.exr";
+  int height = 256;                                    // the map is 2 * height x height
+  std::array<double, 3> sunDir{0.5, 1.0, 0.35};        // towards the sun (world, up = +Y)
+  double sunRadiusDeg = 2.0;                           // angular radius of the disk
+  double sunIrradiance = 3.0;                          // W/m² perpendicular to the sun (per channel)
+  std::array<double, 3> zenith{0.05, 0.08, 0.16};
+  std::array<double, 3> horizon{0.16, 0.17, 0.19};
+  std::array<double, 3> ground{0.05, 0.045, 0.04};
+  std::array<double, 3> glow{0.25, 0.22, 0.16};        // around the sun
+  double glowWidth = 0.25;                             // radians
+};
+int runSky(const SkyParams& p);
+// Writes RGB half-float texels (row-major, top row first) as a ZIP-compressed EXR.
+void writeSkyExr(const std::string& path, int width, int height, const std::vector<float>& rgb);
 
 int runProcedural(const std::string& outDir);
 int runBadInputs(const std::string& outDir);
