@@ -1,5 +1,6 @@
 #include "render/volume_source.h"
 
+#include "core/log.h"
 #include "media/vdb_loader.h"
 
 namespace plume {
@@ -9,6 +10,8 @@ VolumeSource::VolumeSource(gpu::Context& ctx, const Medium& medium, const Volume
 
 VolumeSource::Bake VolumeSource::bakeFile(const std::string& path) const {
   LoadedGrid grid = loadFloatGrid(path, medium_.densityGrid);
+  grid.clampedValues = clampOpticalDepth(*grid.grid, medium_.densityScale);
+  if (grid.clampedValues > 0) warnClamped(grid, medium_.densityScale);
   return {bakeVolume(grid, options_.bake), grid.replacedValues};
 }
 
