@@ -69,7 +69,7 @@ TEST_F(ExtremeSuite, HugeVoxelsRenderLikeTheOriginal) {
 
 TEST_F(ExtremeSuite, DenseAndBright) {
   // 256 bounces at albedo 0.99: long paths on both sides, so a smaller image.
-  checkCase(ctx(), compiler(), caseNamed("dense_bright", {8, 256}), {256, 256, 64});
+  checkCase(ctx(), compiler(), caseNamed("dense_bright", {8, 256}), {256, 256, 256});
 }
 
 TEST_F(ExtremeSuite, StronglyForwardScatteringBacklit) {

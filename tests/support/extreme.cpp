@@ -47,7 +47,6 @@ ExtremeCase makeCase(std::string name, Scene scene, openvdb::FloatGrid::Ptr grid
   c.grid = grid;
   c.referenceScene = scene;
   c.referenceGrid = grid;
-  c.restir = scene.render.maxBounces <= int(shared::RS_MAX_VERTICES);
   return c;
 }
 

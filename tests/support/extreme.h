@@ -29,7 +29,7 @@ struct ExtremeCase {
   Scene referenceScene;
   openvdb::FloatGrid::Ptr referenceGrid;
   uint64_t replaced = 0, clamped = 0;  // by sanitizeGrid and clampOpticalDepth
-  bool restir = true;                  // ReSTIR takes the case (max_bounces within its limit)
+  bool restir = true;                  // ReSTIR renders the case
   bool mediumInView = true;            // the medium covers a good part of the image
 };
 
