@@ -10,6 +10,10 @@ VolumeSource::VolumeSource(gpu::Context& ctx, const Medium& medium, const Volume
 
 VolumeSource::Bake VolumeSource::bakeFile(const std::string& path) const {
   LoadedGrid grid = loadFloatGrid(path, medium_.densityGrid);
+  if (grid.replacedValues > 0) {
+    logWarn(strf("%s: %llu NaN, infinite or negative values replaced by 0", grid.path.c_str(),
+                 (unsigned long long)grid.replacedValues));
+  }
   grid.clampedValues = clampOpticalDepth(*grid.grid, medium_.densityScale);
   if (grid.clampedValues > 0) warnClamped(grid, medium_.densityScale);
   return {bakeVolume(grid, options_.bake), grid.replacedValues};
