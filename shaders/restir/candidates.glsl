@@ -18,7 +18,9 @@ void rs_generate_candidates(uvec2 pixel, uint pixelIndex, uint outSet) {
   RngState rng = rng_init(pixel, frame.frameKey, RNG_STREAM_CANDIDATES, frame.seed);
   uint M = rsp.candidates;
   float invM = 1.0f / float(M);
-  uint maxVertices = min(rsp.prefixVertices, RS_MAX_VERTICES);  // longer paths: rs_tail (shade.glsl)
+  // At most K = rsp.prefixVertices (<= RS_MAX_VERTICES) vertices, none for max_bounces 0; longer
+  // paths: rs_tail (shade.glsl).
+  uint maxVertices = min(min(frame.maxBounces, rsp.prefixVertices), RS_MAX_VERTICES);
   float q = min(1.0f, plume_max3(vtx_albedo(VERTEX_MEDIUM)));
   uint base = rs_bounce_base(outSet, pixelIndex);
   RsReservoir r = rs_empty();
