@@ -67,6 +67,15 @@ float rs_sample_light(vec3 wIn, vec3 u, out uint light, out vec2 ls) {
   return pdf * light_pdf(l, rs_decode_dir(ls), wIn, frame.g);
 }
 
+#ifdef PLUME_HAS_EMISSION
+// The most vertices of a path a reservoir holds that ends in emission: one more than the light
+// paths' min(max_bounces, K) (its last vertex only emits), at most RS_MAX_VERTICES. Longer
+// emitting paths are the tail's (restir/shade.glsl); one-vertex ones final shading's.
+uint rs_emission_vertices() {
+  return min(min(frame.maxBounces + 1u, rsp.prefixVertices + 1u), RS_MAX_VERTICES);
+}
+#endif
+
 // Transmittance: the mean field's deterministic one (target) or residual ratio tracking on the
 // fine grid of the current volume against the same field (unbiased; final shading only, v = 0).
 float rs_transmittance(uint v, vec3 x, vec3 w, float dist, bool unbiased, inout RngState rng) {

@@ -23,9 +23,11 @@ void rs_generate_candidates(uvec2 pixel, uint pixelIndex, uint outSet) {
   RngState rng = rng_init(pixel, frame.frameKey, RNG_STREAM_CANDIDATES, frame.seed);
   uint M = rsp.candidates;
   float invM = 1.0f / float(M);
-  uint maxVertices = min(frame.maxBounces, RS_MAX_VERTICES);  // vertices that scatter to a light
+  // At most K = rsp.prefixVertices (<= RS_MAX_VERTICES) vertices, none for max_bounces 0; longer
+  // paths: rs_tail (shade.glsl).
+  uint maxVertices = min(min(frame.maxBounces, rsp.prefixVertices), RS_MAX_VERTICES);  // scatter to a light
 #ifdef PLUME_HAS_EMISSION
-  uint walkVertices = min(frame.maxBounces + 1u, RS_MAX_VERTICES);  // emission after the last scattering
+  uint walkVertices = rs_emission_vertices();  // one more vertex that only emits
 #else
   uint walkVertices = maxVertices;
 #endif

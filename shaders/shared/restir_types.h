@@ -23,7 +23,7 @@
 
 PLUME_NS_BEGIN
 
-const uint RS_MAX_VERTICES = 16u;  // longest path a reservoir stores (render.max_bounces <= this)
+const uint RS_MAX_VERTICES = 16u;  // longest path a reservoir stores (render.restir_prefix <= this)
 const uint RS_MAX_NEIGHBOURS = 8u;
 const uint RS_LIGHT_EMISSION = 0xFFFFFFFFu;  // RsPathHead.light of a path ending in emission
 
@@ -50,7 +50,7 @@ struct RestirParams {
   GpuCamera prevCamera;     // temporal: the previous frame's camera
   // Candidates (DESIGN §4.2 step 1)
   uint candidates;          // M
-  uint bounceStride;        // path vertex slots per pixel and set (max_bounces - 1, at least 1)
+  uint bounceStride;        // path vertex slots per pixel and set (prefixVertices - 1, at least 1)
   uint pixelCount;
   uint lightCount;
   // Temporal reuse (step 5)
@@ -61,7 +61,9 @@ struct RestirParams {
   // Spatial reuse (step 6)
   uint neighbours;          // k
   float radius;             // px
-  uint pad0;
+  // Candidates and final shading: vertices a reservoir's path holds, min(restir_prefix,
+  // max_bounces); final shading path-traces the paths with more (PLUME_RS_TAIL)
+  uint prefixVertices;
   uint pad1;
 };
 

@@ -43,6 +43,8 @@ int runReference(const ReferenceArgs& a) {
       logWarn(strf("%s: %llu NaN, infinite or negative values replaced by 0", grid.path.c_str(),
                    (unsigned long long)grid.replacedValues));
     }
+    grid.clampedValues = clampOpticalDepth(*grid.grid, medium.densityScale);
+    if (grid.clampedValues > 0) warnClamped(grid, medium.densityScale);
     ref::ReferenceOptions opt;
     opt.frame = frame;
     opt.progress = !a.quiet;

@@ -2,6 +2,7 @@
 #include "media/vdb_loader.h"
 
 #include "core/error.h"
+#include "core/log.h"
 
 #include <openvdb/io/File.h>
 #include <openvdb/tools/Count.h>
@@ -9,8 +10,10 @@
 
 #include <tbb/combinable.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <mutex>
 
 namespace plume {
@@ -167,6 +170,44 @@ uint64_t sanitizeGrid(openvdb::FloatGrid& grid) {
     }
   }
   return count;
+}
+
+double maxMediumValue(const openvdb::FloatGrid& grid, double densityScale) {
+  const openvdb::Vec3d vs = grid.voxelSize();
+  const double side = std::min({vs.x(), vs.y(), vs.z()});
+  if (!(densityScale > 0.0) || !(side > 0.0)) return std::numeric_limits<double>::infinity();
+  return kMaxVoxelOpticalDepth / (densityScale * side);
+}
+
+uint64_t clampOpticalDepth(openvdb::FloatGrid& grid, double densityScale) {
+  const double limitD = maxMediumValue(grid, densityScale);
+  if (!(limitD < double(std::numeric_limits<float>::max()))) return 0;
+  const float limit = float(limitD);
+  tbb::combinable<uint64_t> clamped([] { return uint64_t(0); });
+  openvdb::tree::LeafManager<openvdb::FloatTree> leaves(grid.tree());
+  leaves.foreach([&](openvdb::FloatTree::LeafNodeType& leaf, size_t) {
+    uint64_t n = 0;
+    for (auto it = leaf.beginValueOn(); it; ++it) {
+      if (*it > limit) it.setValue(limit), ++n;
+    }
+    clamped.local() += n;
+  });
+  uint64_t count = clamped.combine(std::plus<uint64_t>());
+  auto it = grid.tree().beginValueOn();
+  it.setMaxDepth(openvdb::FloatTree::ValueOnIter::LEAF_DEPTH - 1);
+  for (; it; ++it) {
+    if (*it > limit) {
+      it.setValue(limit);
+      count += it.getVoxelCount();
+    }
+  }
+  return count;
+}
+
+void warnClamped(const LoadedGrid& grid, double densityScale) {
+  logWarn(strf("%s: %llu values above %.4g (optical depth %g per voxel at density scale %g) clamped to it",
+               grid.path.c_str(), (unsigned long long)grid.clampedValues, maxMediumValue(*grid.grid, densityScale),
+               kMaxVoxelOpticalDepth, densityScale));
 }
 
 std::vector<GridSummary> inspectVdb(const std::string& path) {

@@ -195,6 +195,12 @@ double ReferenceMedium::ratioTracking(const Ray& ray, double tMax, Pcg32& rng, c
   double transmittance = 1.0;
   trackMajorants(ray, tMax, rng, acc, stats, [&](double, double sigma, double maj) {
     transmittance *= std::max(0.0, 1.0 - sigma / maj);  // ratio tracking weight per tentative collision
+    if (transmittance < kRouletteTransmittance) {
+      // Russian roulette (unbiased: E[T'] = q * T / q = T): go on with probability
+      // q = T / kRouletteTransmittance carrying T / q, else stop with 0.
+      const double q = transmittance / kRouletteTransmittance;
+      transmittance = double(rng.uniform()) < q ? kRouletteTransmittance : 0.0;
+    }
     return transmittance > 0.0;
   });
   return transmittance;

@@ -35,6 +35,8 @@ class ReferenceMedium {
  public:
   static constexpr int kCellSize = 8;                  // voxels per majorant cell and axis
   static constexpr uint64_t kMaxTrackingSteps = 1u << 22;
+  // Ratio tracking plays Russian roulette once its transmittance falls below this (medium.cpp).
+  static constexpr double kRouletteTransmittance = 0.1;
 
   ReferenceMedium(openvdb::FloatGrid::ConstPtr grid, float densityScale);
 
@@ -55,7 +57,9 @@ class ReferenceMedium {
   // sigma_t Le / majorant over them).
   bool sampleCollision(const Ray& ray, double tMax, Pcg32& rng, const Accessor& acc, double& tHit,
                        TrackingStats& stats, const std::function<void(double, double, double)>& onTentative) const;
-  // Ratio tracking estimate of the transmittance over (0, tMax) (unbiased, in [0, 1]).
+  // Ratio tracking estimate of the transmittance over (0, tMax) (unbiased, in [0, 1]), with
+  // Russian roulette on small transmittance: a walk through a dense medium stops soon after T
+  // falls below kRouletteTransmittance instead of walking on until T underflows to 0.
   double ratioTracking(const Ray& ray, double tMax, Pcg32& rng, const Accessor& acc,
                        TrackingStats& stats) const;
 

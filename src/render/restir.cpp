@@ -6,14 +6,17 @@
 
 #include <glm/glm.hpp>
 
+#include <algorithm>
 #include <cmath>
 
 namespace plume {
 
 std::string RestirOptions::name() const {
   const char* kind = mis == shared::RS_MIS_GBH ? "gbh" : mis == shared::RS_MIS_BIASED ? "biased" : "pairwise";
-  if (rounds == 0) return strf("restir %s M%d R0 c%d", kind, candidates, historyCap);
-  return strf("restir %s M%d k%d r%d R%d c%d", kind, candidates, neighbours, radius, rounds, historyCap);
+  // The prefix only when it is not the default, so the names of earlier benches still match.
+  const std::string k = prefix == RestirOptions{}.prefix ? "" : strf(" K%d", prefix);
+  if (rounds == 0) return strf("restir %s M%d R0 c%d%s", kind, candidates, historyCap, k.c_str());
+  return strf("restir %s M%d k%d r%d R%d c%d%s", kind, candidates, neighbours, radius, rounds, historyCap, k.c_str());
 }
 
 RestirOptions restirOptionsOf(const RenderSettings& rs) {
@@ -24,6 +27,7 @@ RestirOptions restirOptionsOf(const RenderSettings& rs) {
   o.rounds = rs.restirRounds;
   o.historyCap = rs.restirHistoryCap;
   o.mis = rs.restirMis == "gbh" ? shared::RS_MIS_GBH : shared::RS_MIS_PAIRWISE;
+  o.prefix = rs.restirPrefix;
   return o;
 }
 
@@ -77,14 +81,19 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
     : ctx_(ctx), scene_(scene), options_(options), features_(featuresOf(scene)), timer_(ctx, 32) {
   checkGpuSupports(scene, "ReSTIR");
   envMap_ = std::make_unique<GpuEnvironmentMap>(ctx, scene);  // bad maps fail before compiling
-  // A path of max_bounces scattering vertices, and with emission one more vertex that emits.
-  const int vertices = scene.render.maxBounces + (features_.emission ? 1 : 0);
-  if (vertices > int(shared::RS_MAX_VERTICES)) {
-    throw InputError(scene.path + strf(": render.max_bounces: ReSTIR stores paths of at most %u vertices (got %d%s); "
-                                       "use mode pt for longer paths",
-                                       shared::RS_MAX_VERTICES, vertices,
-                                       features_.emission ? ": max_bounces + 1 for an emitting medium" : ""));
+  if (options_.prefix < 1 || options_.prefix > int(shared::RS_MAX_VERTICES)) {
+    throw InputError(scene.path + strf(": render.restir_prefix: expected 1 to %u (got %d)", shared::RS_MAX_VERTICES,
+                                       options_.prefix));
   }
+  // Reservoirs hold paths of at most `prefix` vertices; a longer max_bounces adds the tail, a
+  // path-traced estimate of the paths with more vertices, to final shading (restir/shade.glsl).
+  // In an emitting medium a reservoir's path may end with one more vertex that only emits
+  // (rs_emission_vertices: min(max_bounces, prefix) + 1, at most RS_MAX_VERTICES), and the tail
+  // also gathers the emission of longer paths.
+  const int prefix = std::min(options_.prefix, std::max(1, scene.render.maxBounces));
+  const int emitting = std::min({scene.render.maxBounces + 1, prefix + 1, int(shared::RS_MAX_VERTICES)});
+  const bool tail = scene.render.maxBounces > prefix || (features_.emission && scene.render.maxBounces + 1 > emitting);
+  const int vertices = features_.emission ? emitting : prefix;  // stored per path
   if (options_.neighbours > int(shared::RS_MAX_NEIGHBOURS)) {
     throw InputError(scene.path + strf(": render.restir_neighbours: at most %u", shared::RS_MAX_NEIGHBOURS));
   }
@@ -120,7 +129,8 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   candidates_ = make("passes/restir_candidates.comp", "restir candidates", {});
   temporal_ = make("passes/restir_reuse.comp", "restir temporal", {{"PLUME_RS_TEMPORAL", "1"}});
   spatial_ = make("passes/restir_reuse.comp", "restir spatial", {{"PLUME_RS_TEMPORAL", "0"}});
-  shade_ = make("passes/restir_shade.comp", "restir shade", {});
+  shade_ = make("passes/restir_shade.comp", "restir shade",
+                tail ? gpu::ShaderDefines{{"PLUME_RS_TAIL", "1"}} : gpu::ShaderDefines{});
 
   const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   const size_t pixels = size_t(scene.camera.width) * scene.camera.height;
@@ -153,6 +163,7 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   }
   params_.candidates = uint32_t(options_.candidates);
   params_.bounceStride = stride;
+  params_.prefixVertices = uint32_t(prefix);
   params_.pixelCount = uint32_t(pixels);
   params_.lightCount = uint32_t(scene.lights.size());
   params_.historyCap = float(options_.historyCap);

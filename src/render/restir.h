@@ -31,6 +31,8 @@ struct RestirOptions {
   int rounds = 1;            // R (0: no spatial reuse)
   int historyCap = 20;       // c (0: no temporal reuse)
   uint32_t mis = shared::RS_MIS_PAIRWISE;
+  int prefix = 16;           // K: vertices a reservoir's path holds (<= RS_MAX_VERTICES); the paths
+                             // of more vertices are path traced in final shading (notes/restir.md)
   std::string name() const;  // e.g. "restir pairwise M4 k3 r16 R1 c20" (r: radius in px)
 };
 // From the scene's render settings (render.restir_mis; mode restir-biased's RS_MIS_BIASED is set

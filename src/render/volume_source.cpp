@@ -1,5 +1,6 @@
 #include "render/volume_source.h"
 
+#include "core/log.h"
 #include "media/vdb_loader.h"
 
 namespace plume {
@@ -9,9 +10,19 @@ VolumeSource::VolumeSource(gpu::Context& ctx, const Medium& medium, const Volume
 
 VolumeSource::Bake VolumeSource::bakeFile(const std::string& path) const {
   LoadedGrid grid = loadFloatGrid(path, medium_.densityGrid);
+  if (grid.replacedValues > 0) {
+    logWarn(strf("%s: %llu NaN, infinite or negative values replaced by 0", grid.path.c_str(),
+                 (unsigned long long)grid.replacedValues));
+  }
+  grid.clampedValues = clampOpticalDepth(*grid.grid, medium_.densityScale);
+  if (grid.clampedValues > 0) warnClamped(grid, medium_.densityScale);
   Bake bake{bakeVolume(grid, options_.bake), grid.replacedValues};
   if (medium_.emission) {  // only a grid the scene uses is loaded
     LoadedGrid emission = loadFloatGrid(path, medium_.emission->grid);
+    if (emission.replacedValues > 0) {
+      logWarn(strf("%s: grid \"%s\": %llu NaN, infinite or negative values replaced by 0", emission.path.c_str(),
+                   emission.name.c_str(), (unsigned long long)emission.replacedValues));
+    }
     bakeEmission(bake.volume, grid, emission);
     bake.replacedValues += emission.replacedValues;
   }

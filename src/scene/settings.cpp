@@ -29,6 +29,10 @@ const std::vector<SettingDesc>& renderSettingsTable() {
        &RenderSettings::restirHistoryCap, 0, 1000, {}},
       {"restir_mis", "ReSTIR: MIS weights for reuse: pairwise (O(k)) or gbh (generalised balance heuristic, O(k^2))",
        &RenderSettings::restirMis, 0, 0, {"pairwise", "gbh"}},
+      {"restir_prefix",
+       "ReSTIR: scattering vertices a reservoir's path holds (1-16, shared::RS_MAX_VERTICES); paths with more "
+       "(up to max_bounces) are path traced in final shading",
+       &RenderSettings::restirPrefix, 1, 16, {}},
   };
   return table;
 }

@@ -27,6 +27,7 @@ struct RenderSettings {
   int restirRounds = 1;              // R: spatial rounds (0 = no spatial reuse)
   int restirHistoryCap = 20;         // temporal confidence cap c: M_hist <= c * M_cur (0 = no temporal)
   std::string restirMis = "pairwise";  // pairwise | gbh (generalised balance heuristic)
+  int restirPrefix = 16;             // path vertices a reservoir holds; longer paths: a path-traced tail
 };
 
 struct SettingDesc {

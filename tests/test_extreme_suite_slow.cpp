@@ -1,0 +1,97 @@
+// The extreme-media suite at a larger size (issue 13, support/extreme.h): every case by every
+// estimator at 32², the dense-and-bright cloud at 256 bounces Z-tested at that size, and the
+// suite's table (case x estimator: mean ratio to the reference, relMSE, time, truncated loops,
+// non-finite values) written to build/test-output/extreme/extreme.md; tools/extreme-bench
+// runs this and copies the table into notes/bench/extreme.md.
+#include "core/stats.h"
+#include "shaders/shared/restir_types.h"
+#include "support/extreme.h"
+#include "support/gpu_fixture.h"
+#include "support/reference_check.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+using namespace plume;
+
+namespace {
+
+class ExtremeSuiteSlow : public test::GpuTest {};
+
+std::string row(const test::ExtremeCase& c, const char* estimator, const test::EstimatorRun& run,
+                const test::EstimatorRun& ref, int samples) {
+  char line[512];
+  const test::AggregateZResult agg = test::aggregateZTest(run.image, ref.image);
+  const glm::dvec3 ratio = agg.meanRatio();
+  const double ratioMean = (ratio.x + ratio.y + ratio.z) / 3.0;
+  std::snprintf(line, sizeof line, "| %s | %s | %d | %.4f | %.3g | %.2f | %llu | %llu |\n", c.name.c_str(), estimator,
+                samples, ratioMean, relMse(run.image, ref.image), run.seconds, (unsigned long long)run.truncated,
+                (unsigned long long)run.nonFinite);
+  return line;
+}
+
+}  // namespace
+
+TEST_F(ExtremeSuiteSlow, Table) {
+  constexpr int kPixels = 32, kRefSpp = 1024, kPtSpp = 256, kRestirRuns = 64;
+  std::string table =
+      "| case | estimator | spp (ReSTIR: runs) | mean ratio to reference | relMSE vs reference | seconds | "
+      "truncated | non-finite |\n|---|---|---|---|---|---|---|---|\n";
+  for (const test::ExtremeCase& c : test::extremeCases({kPixels, 256})) {
+    const test::EstimatorRun ref = test::runReferenceCase(c, kRefSpp);
+    const test::EstimatorRun pt = test::runPtCase(ctx(), compiler(), c, kPtSpp);
+    for (const auto* run : {&ref, &pt}) {
+      EXPECT_EQ(run->truncated, 0u) << c.name;
+      EXPECT_EQ(run->nonFinite, 0u) << c.name;
+    }
+    table += row(c, "reference", ref, ref, kRefSpp);
+    table += row(c, "pt", pt, ref, kPtSpp);
+    if (c.restir) {
+      const test::EstimatorRun rs = test::runRestirCase(ctx(), compiler(), c, kRestirRuns, shared::RS_MIS_PAIRWISE);
+      EXPECT_EQ(rs.truncated, 0u) << c.name;
+      EXPECT_EQ(rs.nonFinite, 0u) << c.name;
+      table += row(c, "restir pairwise", rs, ref, kRestirRuns);
+    } else {
+      table += "| " + c.name + " | restir pairwise | - | - | - | - | - | - |\n";
+    }
+    std::printf("%s", table.c_str());
+    std::fflush(stdout);
+  }
+  const std::filesystem::path dir = std::filesystem::path(PLUME_BINARY_DIR) / "test-output" / "extreme";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "extreme.md") << table;
+}
+
+// Open (notes/extreme.md, finding 1): fails today, the path tracer's mean 3.7% below the
+// reference's (aggregate z -9..-10, 1 of 256 pixels fails the per-pixel test); the CI version
+// (test_extreme_suite.cpp, 8², 256/256 spp) resolves only ~7% and passes.
+TEST_F(ExtremeSuiteSlow, DISABLED_DenseAndBright256BouncesMatchesReference) {
+  const std::vector<test::ExtremeCase> cases = test::extremeCases({16, 256});
+  for (const test::ExtremeCase& c : cases) {
+    if (c.name != "dense_bright") continue;
+    const test::EstimatorRun ref = test::runReferenceCase(c, 2048);
+    const test::EstimatorRun pt = test::runPtCase(ctx(), compiler(), c, 1024);
+    EXPECT_EQ(ref.truncated + pt.truncated + ref.nonFinite + pt.nonFinite, 0u);
+    test::ReferenceCheckOptions options;
+    options.outputGroup = "extreme_suite";
+    test::expectMatchesReference(pt.image, ref.image, "dense_bright_256_pt", options);
+  }
+}
+
+// The issue's bounded-time case: the values grid at 64², 16 samples per pixel, every estimator
+// (seconds, not minutes; no tracking loop truncated).
+TEST_F(ExtremeSuiteSlow, ValuesGridAt64x64With16SppIsFast) {
+  for (const test::ExtremeCase& c : test::extremeCases({64, 256})) {
+    if (c.name != "values_1e-30_1e30") continue;
+    const test::EstimatorRun ref = test::runReferenceCase(c, 16);
+    const test::EstimatorRun pt = test::runPtCase(ctx(), compiler(), c, 16);
+    const test::EstimatorRun rs = test::runRestirCase(ctx(), compiler(), c, 16, shared::RS_MIS_PAIRWISE);
+    for (const auto* run : {&ref, &pt, &rs}) {
+      EXPECT_EQ(run->truncated, 0u);
+      EXPECT_EQ(run->nonFinite, 0u);
+    }
+    std::printf("[extreme] values grid 64x64, 16 spp: reference %.2f s, pt %.2f s, restir (16 runs) %.2f s\n",
+                ref.seconds, pt.seconds, rs.seconds);
+  }
+}
