@@ -275,9 +275,10 @@ Image restirMean(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& 
 }
 
 void compareRestir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene, const RestirOptions& options,
-                   int frames, int refSpp, const std::string& label) {
-  auto density = test::makeNoiseGrid(40, 1.0 / 20, 3);
-  auto emission = test::makeNoiseGrid(40, 1.0 / 20, 8);
+                   int frames, int refSpp, const std::string& label, openvdb::FloatGrid::Ptr density = nullptr,
+                   openvdb::FloatGrid::Ptr emission = nullptr) {
+  if (!density) density = test::makeNoiseGrid(40, 1.0 / 20, 3);
+  if (!emission) emission = test::makeNoiseGrid(40, 1.0 / 20, 8);
   test::ReferenceCheckOptions opt;
   opt.outputGroup = "emission";
   glm::dvec3 meanVariance;
@@ -341,6 +342,43 @@ TEST_F(GpuEmission, RestirShortPrefixWithEmissionTailMatchesReference) {
   o.radius = 6;
   o.prefix = 2;
   compareRestir(ctx(), compiler(), s, o, 1, 1024, "restir_prefix2_tail");
+}
+
+// The Blender fire (Mantaflow's temperature as blackbody) with ReSTIR. `temporal`: three frames
+// with temporal and spatial reuse; without: one frame, spatial reuse only.
+void compareRestirBlenderFire(gpu::Context& ctx, gpu::ShaderCompiler& compiler, bool temporal, float emissionScale,
+                              const std::string& label) {
+  const std::string shared = test::sharedVolumesPath();
+  if (shared.empty()) GTEST_SKIP() << test::sharedVolumesMissing();
+  const std::string file = shared + "/fire/fire_0020.vdb";
+  Scene s = emittingScene({1.0f, -2.6f, 1.4f}, {1.0f, 1.0f, 1.1f}, 16, 40.0f);
+  s.camera.base.up = {0.0f, 0.0f, 1.0f};
+  s.media[0].densityScale = 12.0f;
+  s.media[0].albedo = glm::vec3(0.5f);
+  s.media[0].g = 0.2f;
+  s.media[0].emission = Emission{.grid = "temperature", .scale = emissionScale, .blackbody = true, .temperatureScale = 800.0f};
+  s.render.maxBounces = 4;
+  s.render.seed = 4242;
+  RestirOptions o;
+  o.radius = 2;
+  if (!temporal) o.historyCap = 0;
+  compareRestir(ctx, compiler, s, o, temporal ? 3 : 1, 8192, label, loadFloatGrid(file, "density").grid,
+                loadFloatGrid(file, "temperature").grid);
+}
+
+TEST_F(GpuEmission, RestirBlenderFireSpatialMatchesReference) {
+  compareRestirBlenderFire(ctx(), compiler(), false, 6.0f, "restir_blender_fire_spatial");
+}
+
+// OPEN (notes/restir.md, session 5): with temporal reuse over three frames of the still Blender
+// fire, ReSTIR is biased high on this grid *without any emission* (emission scale 0, the dim sun
+// alone: aggregate mean ratio 1.016, z 2.65; pixel (5, 8) z 5.3, the same pixel for two reference
+// seeds and 2048 or 8192 reference samples), while no reuse and spatial reuse alone pass. Emission
+// is not the cause: a scene with no emission at all (test_restir.cpp's harness, same camera,
+// grid and sun) fails the same way (mean ratio 1.0106, a pixel at z 5.16). The temporal path on
+// Mantaflow's thin wisps (values down to 1e-6) is the suspect. Enable when found.
+TEST_F(GpuEmission, DISABLED_RestirBlenderFireTemporalMatchesReference) {
+  compareRestirBlenderFire(ctx(), compiler(), true, 0.0f, "restir_blender_fire_temporal_no_emission");
 }
 
 }  // namespace
