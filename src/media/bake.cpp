@@ -162,23 +162,29 @@ struct SlotResult {
   float majorant = 0, maxAbsError = 0, maxValue = 0;
 };
 
+// Calls put(atlas texel index, window value) for every texel of slot `slot` (the density's atlas
+// and the emission channel share the layout).
+template <typename Put>
+void forSlotTexels(const BakedVolume& vol, uint32_t slot, const Window& w, Put&& put) {
+  const glm::ivec3 o = slotTexelOrigin(vol, slot);
+  for (int z = 0; z < kBrickTexels; ++z)
+    for (int y = 0; y < kBrickTexels; ++y) {
+      const size_t row = linearIndex(o + glm::ivec3(0, y, z), vol.atlasTexels);
+      for (int x = 0; x < kBrickTexels; ++x) put(row + size_t(x), w[windowIndex(x, y, z)]);
+    }
+}
+
 // Writes the window into slot `slot` of the atlas. The majorant is the max over the window of
 // both the float value and the stored value (half rounding may round up), so it bounds the
 // trilinear lookup of either: a convex combination of 8 window texels never exceeds their max.
 SlotResult writeTexels(BakedVolume& vol, uint32_t slot, const Window& w) {
   SlotResult r;
-  const glm::ivec3 o = slotTexelOrigin(vol, slot);
-  for (int z = 0; z < kBrickTexels; ++z)
-    for (int y = 0; y < kBrickTexels; ++y) {
-      const size_t row = linearIndex(o + glm::ivec3(0, y, z), vol.atlasTexels);
-      for (int x = 0; x < kBrickTexels; ++x) {
-        const float v = w[windowIndex(x, y, z)];
-        const float s = storeTexel(vol, row + size_t(x), v);
-        r.majorant = std::max({r.majorant, v, s});
-        r.maxValue = std::max(r.maxValue, v);
-        r.maxAbsError = std::max(r.maxAbsError, std::abs(s - v));
-      }
-    }
+  forSlotTexels(vol, slot, w, [&](size_t texel, float v) {
+    const float s = storeTexel(vol, texel, v);
+    r.majorant = std::max({r.majorant, v, s});
+    r.maxValue = std::max(r.maxValue, v);
+    r.maxAbsError = std::max(r.maxAbsError, std::abs(s - v));
+  });
   return r;
 }
 
@@ -380,16 +386,10 @@ void bakeEmission(BakedVolume& vol, const LoadedGrid& density, const LoadedGrid&
     for (size_t k = r.begin(); k != r.end(); ++k) {
       const auto [i, slot] = slots[k];
       gatherWindow(acc, vol.brickOrigin + delinearize(i, vol.brickDims), w);
-      const glm::ivec3 o = slotTexelOrigin(vol, slot);
-      for (int z = 0; z < kBrickTexels; ++z)
-        for (int y = 0; y < kBrickTexels; ++y) {
-          const size_t row = linearIndex(o + glm::ivec3(0, y, z), vol.atlasTexels);
-          for (int x = 0; x < kBrickTexels; ++x) {
-            const float v = w[windowIndex(x, y, z)];
-            vol.emissionF32[row + size_t(x)] = v;
-            mx = std::max(mx, v);
-          }
-        }
+      forSlotTexels(vol, slot, w, [&](size_t texel, float v) {
+        vol.emissionF32[texel] = v;
+        mx = std::max(mx, v);
+      });
     }
   });
   vol.emissionMax = maxima.combine([](float x, float y) { return std::max(x, y); });
