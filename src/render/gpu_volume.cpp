@@ -95,7 +95,8 @@ GpuVolumeResources::GpuVolumeResources(gpu::Context& ctx, const BakedVolume& bak
     paramBuffer_.upload(&params_, sizeof(params_));
     emissionAtlas_ = gpu::Image3D(ctx, bake.atlasTexels, VK_FORMAT_R32_SFLOAT, 4, "emission atlas");
     emissionAtlas_.upload(bake.emissionF32.data(), bake.emissionF32.size() * 4);
-    const std::vector<glm::vec4> table = blackbodyTable();
+    // The same for every volume: integrated once per process (4096 spectral integrals), not per frame.
+    static const std::vector<glm::vec4> table = blackbodyTable();
     blackbody_ = gpu::Buffer(ctx, table.size() * sizeof(glm::vec4), storage, "blackbody table");
     blackbody_.upload(table.data(), table.size() * sizeof(glm::vec4));
     bytes_ += bake.emissionF32.size() * 4 + table.size() * sizeof(glm::vec4);
