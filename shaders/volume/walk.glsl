@@ -20,6 +20,9 @@
 
 #include "../shared/dda.h"
 #include "../shared/rng.h"
+#ifdef PLUME_KERNEL_COUNTERS
+#include "counters.glsl"
+#endif
 
 const uint VOL_MAX_STEPS = 1u << 20;  // per tracking call; hits are counted in volCounters[0]
 const float VOL_MAX_TAU = 80.0f;      // the mean field's optical depth is clamped here: exp(-80) > 0
@@ -263,11 +266,17 @@ VolTrack vol_track(uint tracker, uint v, vec3 xWorld, vec3 wWorld, float tMax, f
   VolWalk w;
   if (!vol_walk_start(field, v, o, d, tMax, w)) return s;
   uint steps = 0u;
+#ifdef PLUME_KERNEL_COUNTERS
+  VolKc kc = vol_kc_start();
+#endif
   float scale = vol_scale(v);  // sigma_t = scale * d, read once per walk
   float a;
   float b;
   vec2 value;
   while (vol_track_alive(tracker, s) && vol_walk_next(field, w, a, b, value)) {
+#ifdef PLUME_KERNEL_COUNTERS
+    vol_kc_segment(kc);
+#endif
     float mu = vol_track_segment(tracker, s, a, b, value);
     if (!(mu > 0.0f)) continue;
     float t = a;
@@ -276,14 +285,23 @@ VolTrack vol_track(uint tracker, uint v, vec3 xWorld, vec3 wWorld, float tMax, f
         s.stop = true;
         break;
       }
+#ifdef PLUME_KERNEL_COUNTERS
+      vol_kc_step(kc);
+#endif
       uvec4 h = rng_next4(rng);
       t -= log(1.0f - rng_to_float(h.x)) / mu;
       if (!(t < b)) break;
+#ifdef PLUME_KERNEL_COUNTERS
+      vol_kc_lookup(kc);
+#endif
       vol_track_event(tracker, s, v, scale, o + t * d, t, mu, value, rng_to_float(h.y), rng);
       if (s.stop) break;
     }
   }
   if (steps > VOL_MAX_STEPS) atomicAdd(volCounters[0], 1u);  // truncated: counted, never silent
+#ifdef PLUME_KERNEL_COUNTERS
+  vol_kc_flush(tracker, kc, min(steps, VOL_MAX_STEPS));
+#endif
   return s;
 }
 

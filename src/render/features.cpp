@@ -11,6 +11,7 @@ gpu::ShaderDefines FeatureSet::defines() const {
   if (multiBounce) d.emplace_back("PLUME_MULTI_BOUNCE", "1");
   if (emission) d.emplace_back("PLUME_HAS_EMISSION", "1");
   if (blackbody) d.emplace_back("PLUME_EMISSION_BLACKBODY", "1");
+  if (kernelCounters) d.emplace_back("PLUME_KERNEL_COUNTERS", "1");
   return d;
 }
 
@@ -27,6 +28,7 @@ std::string FeatureSet::name() const {
   add(envMap, "envmap");
   add(multiBounce, "multi");
   add(emission, blackbody ? "blackbody" : "emission");
+  add(kernelCounters, "counters");
   return n.empty() ? "none" : n;
 }
 

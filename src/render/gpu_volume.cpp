@@ -79,7 +79,7 @@ GpuVolumeResources::GpuVolumeResources(gpu::Context& ctx, const BakedVolume& bak
   if (coarse.empty()) coarse.assign(4, 0u);
   coarse_ = gpu::Buffer(ctx, coarse.size() * 4, storage, "mean field");
   coarse_.upload(coarse.data(), coarse.size() * 4);
-  counters_ = gpu::Buffer(ctx, 16, storage, "tracking counters");
+  counters_ = gpu::Buffer(ctx, shared::KC_WORDS * 4, storage, "tracking counters");
   resetCounters();
   bytes_ = sizeof(params_) + atlasBytes + bake.indirection.size() * 4 + majorants.size() * 4 + coarse.size() * 4;
 
@@ -138,9 +138,15 @@ uint32_t GpuVolumeResources::truncatedCount() const {
   return c[0];
 }
 
+std::vector<uint32_t> GpuVolumeResources::counterWords() const {
+  std::vector<uint32_t> words(shared::KC_WORDS);
+  counters_.download(words.data(), words.size() * 4);
+  return words;
+}
+
 void GpuVolumeResources::resetCounters() {
-  const uint32_t zero[4] = {0, 0, 0, 0};
-  counters_.upload(zero, sizeof zero);
+  const std::vector<uint32_t> zero(shared::KC_WORDS, 0u);
+  counters_.upload(zero.data(), zero.size() * 4);
 }
 
 }  // namespace plume

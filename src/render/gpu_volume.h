@@ -10,6 +10,9 @@
 #include "scene/scene.h"
 #include "shaders/shared/bindings.h"
 #include "shaders/shared/gpu_types.h"
+#include "shaders/shared/kernel_counters.h"
+
+#include <vector>
 
 namespace plume {
 
@@ -41,6 +44,9 @@ class GpuVolumeResources {
 
   // Tracking loops truncated by the step cap since the last reset (no silent caps).
   uint32_t truncatedCount() const;
+  // The whole counter buffer (shared::KC_WORDS words): after the volume's own, the kernel
+  // benchmark's counters (shared/kernel_counters.h; zero unless a pass compiled them in).
+  std::vector<uint32_t> counterWords() const;
   void resetCounters();
 
  private:

@@ -10,8 +10,9 @@
 
 namespace plume {
 
-PathTracer::PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene)
+PathTracer::PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene, bool kernelCounters)
     : ctx_(ctx), scene_(scene), features_(featuresOf(scene)), compiler_(compiler), timer_(ctx) {
+  features_.kernelCounters = kernelCounters;
   checkGpuSupports(scene, "the GPU path tracer");
   envMap_ = std::make_unique<GpuEnvironmentMap>(ctx, scene);
   const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;

@@ -18,7 +18,8 @@ namespace plume {
 
 class PathTracer {
  public:
-  PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene);
+  // kernelCounters: FeatureSet::kernelCounters (the kernel benchmark only).
+  PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene, bool kernelCounters = false);
 
   const FeatureSet& features() const { return features_; }
   // Binds a volume; call again when the volume changes (animation). Large brick grids use the

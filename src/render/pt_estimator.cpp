@@ -13,8 +13,9 @@ bool usesSetting(const std::string& key) { return key.rfind("restir_", 0) != 0; 
 
 class PathTracerEstimator final : public Estimator {
  public:
-  PathTracerEstimator(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene, int batch)
-      : scene_(scene), tracer_(ctx, compiler, scene), batch_(batch) {}
+  PathTracerEstimator(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene, int batch,
+                      bool kernelCounters)
+      : scene_(scene), tracer_(ctx, compiler, scene, kernelCounters), batch_(batch) {}
 
   std::string name() const override { return "path tracer [" + tracer_.features().name() + "]"; }
   void setVolumes(const GpuVolumeResources& current, const GpuVolumeResources*) override { tracer_.setVolume(current); }
@@ -65,7 +66,7 @@ EstimatorTraits pathTracerTraits() {
 
 std::unique_ptr<Estimator> makePathTracerEstimator(gpu::Context& ctx, gpu::ShaderCompiler& compiler,
                                                    const Scene& scene, const EstimatorOptions& options) {
-  return std::make_unique<PathTracerEstimator>(ctx, compiler, scene, options.batch);
+  return std::make_unique<PathTracerEstimator>(ctx, compiler, scene, options.batch, options.kernelCounters);
 }
 
 }  // namespace plume

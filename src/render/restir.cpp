@@ -77,8 +77,10 @@ constexpr uint32_t kSets = 3;  // candidates / temporal / spatial rotate through
 
 }  // namespace
 
-Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene, const RestirOptions& options)
+Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene, const RestirOptions& options,
+               bool kernelCounters)
     : ctx_(ctx), scene_(scene), options_(options), features_(featuresOf(scene)), timer_(ctx, 32) {
+  features_.kernelCounters = kernelCounters;
   checkGpuSupports(scene, "ReSTIR");
   envMap_ = std::make_unique<GpuEnvironmentMap>(ctx, scene);  // bad maps fail before compiling
   if (options_.prefix < 1 || options_.prefix > int(shared::RS_MAX_VERTICES)) {

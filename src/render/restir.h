@@ -41,7 +41,9 @@ RestirOptions restirOptionsOf(const RenderSettings& rs);
 
 class Restir {
  public:
-  Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene, const RestirOptions& options);
+  // kernelCounters: FeatureSet::kernelCounters (the kernel benchmark only).
+  Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene, const RestirOptions& options,
+         bool kernelCounters = false);
 
   const RestirOptions& options() const { return options_; }
   const FeatureSet& features() const { return features_; }

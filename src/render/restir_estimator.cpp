@@ -13,8 +13,9 @@ bool usesSetting(const std::string&) { return true; }
 
 class RestirEstimator final : public Estimator {
  public:
-  RestirEstimator(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene, const RestirOptions& options)
-      : scene_(scene), restir_(ctx, compiler, scene, options) {}
+  RestirEstimator(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene, const RestirOptions& options,
+                  bool kernelCounters)
+      : scene_(scene), restir_(ctx, compiler, scene, options, kernelCounters) {}
 
   std::string name() const override { return "ReSTIR [" + restir_.options().name() + "]"; }
   void setVolumes(const GpuVolumeResources& current, const GpuVolumeResources* previous) override {
@@ -120,13 +121,13 @@ EstimatorTraits restirTraits() {
 }
 
 std::unique_ptr<Estimator> makeRestirEstimator(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene,
-                                               const EstimatorOptions&) {
-  return std::make_unique<RestirEstimator>(ctx, compiler, scene, optionsFor(scene, false));
+                                               const EstimatorOptions& options) {
+  return std::make_unique<RestirEstimator>(ctx, compiler, scene, optionsFor(scene, false), options.kernelCounters);
 }
 
 std::unique_ptr<Estimator> makeRestirBiasedEstimator(gpu::Context& ctx, gpu::ShaderCompiler& compiler,
-                                                     const Scene& scene, const EstimatorOptions&) {
-  return std::make_unique<RestirEstimator>(ctx, compiler, scene, optionsFor(scene, true));
+                                                     const Scene& scene, const EstimatorOptions& options) {
+  return std::make_unique<RestirEstimator>(ctx, compiler, scene, optionsFor(scene, true), options.kernelCounters);
 }
 
 }  // namespace plume

@@ -16,6 +16,7 @@
 #include "shared/gpu_types.h"
 #include "shared/restir_types.h"
 #include "shared/bindings.h"
+#include "shared/kernel_counters.h"
 
 // restir_mis.h reads its inputs through accessor macros (here: small tables).
 float misM[3];
@@ -121,6 +122,9 @@ void main() {
   // blackbody.h
   s += bb_lookup(1000.0f + 9000.0f * u.x) * bb_table_kelvin(i % BB_TABLE_SIZE) * BB_TABLE_MAX_K * BB_TABLE_MIN_K +
        vec3(float(BIND_BLACKBODY + BIND_EMISSION_ATLAS + BIND_PREV_EMISSION_ATLAS + EMISSION_BINDING_COUNT));
+  // kernel_counters.h
+  s += vec3(float(KC_WORDS + KC_WALKS + KC_SEGMENTS + KC_SEGMENT_ITERS + KC_STEPS + KC_STEP_ITERS + KC_LOOKUPS +
+                  KC_LOOKUP_ITERS));
   values[i] = vec4(s + wo, t + m + (picked ? 1.0f : 0.0f) + (dropped ? 2.0f : 0.0f) +
                    (rs_is_finite(back.W) ? back.W : 0.0f));
 }
