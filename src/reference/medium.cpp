@@ -1,6 +1,7 @@
 #include "reference/medium.h"
 
 #include "core/error.h"
+#include "reference/counters.h"
 
 #include <openvdb/tools/Interpolation.h>
 
@@ -136,14 +137,15 @@ bool ReferenceMedium::nextSegment(Walk& w, double& t0, double& t1, double& major
 }
 
 template <typename OnCollision>
-void ReferenceMedium::trackMajorants(const Ray& ray, double tMax, Pcg32& rng, const Accessor& acc,
+void ReferenceMedium::trackMajorants(WalkKind kind, const Ray& ray, double tMax, Pcg32& rng, const Accessor& acc,
                                      TrackingStats& stats, OnCollision&& onCollision) const {
   Walk w;
   if (!startWalk(ray, tMax, w)) return;
-  uint64_t steps = 0;
+  uint64_t steps = 0, segments = 0, lookups = 0;  // lookups and segments: the kernel benchmark's only
   double a, b, maj;
   bool going = true;
   while (going && nextSegment(w, a, b, maj)) {
+    ++segments;
     if (maj <= 0.0) continue;
     for (double t = a;;) {
       if (++steps > kMaxTrackingSteps) {
@@ -153,6 +155,7 @@ void ReferenceMedium::trackMajorants(const Ray& ray, double tMax, Pcg32& rng, co
       }
       t -= std::log(1.0 - double(rng.uniform())) / maj;
       if (t >= b) break;
+      ++lookups;
       const glm::dvec3 p = w.o + t * w.d;
       const double sigma = densityScale_ * openvdb::tools::BoxSampler::sample(acc, openvdb::Vec3R(p.x, p.y, p.z));
       if (!onCollision(t, sigma, maj)) {
@@ -162,12 +165,13 @@ void ReferenceMedium::trackMajorants(const Ray& ray, double tMax, Pcg32& rng, co
     }
   }
   stats.steps.fetch_add(steps, std::memory_order_relaxed);
+  if (kernelCounting()) countWalk(kind, segments, std::min(steps, kMaxTrackingSteps), lookups);
 }
 
 bool ReferenceMedium::sampleCollision(const Ray& ray, double tMax, Pcg32& rng, const Accessor& acc,
                                       double& tHit, TrackingStats& stats) const {
   bool hit = false;
-  trackMajorants(ray, tMax, rng, acc, stats, [&](double t, double sigma, double maj) {
+  trackMajorants(WalkKind::Collision, ray, tMax, rng, acc, stats, [&](double t, double sigma, double maj) {
     if (!(double(rng.uniform()) * maj < sigma)) return true;  // a null collision: go on
     tHit = t;  // real collision with probability sigma / maj
     hit = true;
@@ -180,7 +184,7 @@ bool ReferenceMedium::sampleCollision(const Ray& ray, double tMax, Pcg32& rng, c
                                       TrackingStats& stats,
                                       const std::function<void(double, double, double)>& onTentative) const {
   bool hit = false;
-  trackMajorants(ray, tMax, rng, acc, stats, [&](double t, double sigma, double maj) {
+  trackMajorants(WalkKind::Collision, ray, tMax, rng, acc, stats, [&](double t, double sigma, double maj) {
     onTentative(t, sigma, maj);
     if (!(double(rng.uniform()) * maj < sigma)) return true;
     tHit = t;
@@ -193,7 +197,7 @@ bool ReferenceMedium::sampleCollision(const Ray& ray, double tMax, Pcg32& rng, c
 double ReferenceMedium::ratioTracking(const Ray& ray, double tMax, Pcg32& rng, const Accessor& acc,
                                       TrackingStats& stats) const {
   double transmittance = 1.0;
-  trackMajorants(ray, tMax, rng, acc, stats, [&](double, double sigma, double maj) {
+  trackMajorants(WalkKind::Transmittance, ray, tMax, rng, acc, stats, [&](double, double sigma, double maj) {
     transmittance *= std::max(0.0, 1.0 - sigma / maj);  // ratio tracking weight per tentative collision
     if (transmittance < kRouletteTransmittance) {
       // Russian roulette (unbiased: E[T'] = q * T / q = T): go on with probability

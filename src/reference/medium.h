@@ -8,6 +8,7 @@
 // A, so sigma_t = densityScale * d(x) stays "per world unit" along t.
 #pragma once
 
+#include "reference/counters.h"
 #include "reference/ref_rng.h"
 
 #include <glm/vec3.hpp>
@@ -76,7 +77,7 @@ class ReferenceMedium {
   // handed to onCollision(t, sigma_t(t), majorant), which returns false to stop. Truncation by
   // kMaxTrackingSteps is counted in stats and ends the walk (no silent caps).
   template <typename OnCollision>
-  void trackMajorants(const Ray& ray, double tMax, Pcg32& rng, const Accessor& acc, TrackingStats& stats,
+  void trackMajorants(WalkKind kind, const Ray& ray, double tMax, Pcg32& rng, const Accessor& acc, TrackingStats& stats,
                       OnCollision&& onCollision) const;
 
   openvdb::FloatGrid::ConstPtr grid_;
