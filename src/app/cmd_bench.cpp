@@ -5,8 +5,11 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "bench/bench.h"
+#include "bench/kernels.h"
 
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <memory>
 
 namespace plume {
@@ -17,7 +20,18 @@ struct BenchArgs {
   int width = 64, height = 64;
   BenchOptions options;
   SettingOverrides overrides;
+  bool kernels = false;
+  KernelBenchOptions kernel;
 };
+
+// This process's command line (Linux), for the kernel table's notes; empty where unknown.
+std::string commandLine() {
+  std::ifstream in("/proc/self/cmdline", std::ios::binary);
+  std::string all((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()), line;
+  for (char c : all) line += c == '\0' ? ' ' : c;
+  while (!line.empty() && line.back() == ' ') line.pop_back();
+  return line;
+}
 
 int runBenchCommand(const BenchArgs& a) {
   Scene scene = loadScene(a.scene);
@@ -28,6 +42,15 @@ int runBenchCommand(const BenchArgs& a) {
   o.outDir = a.out;
   gpu::Context ctx({a.device, false, true});
   gpu::ShaderCompiler compiler({}, gpu::ShaderCompiler::defaultCacheDir());
+  if (a.kernels) {
+    KernelBenchOptions k = a.kernel;
+    k.gridFrame = a.options.gridFrame;
+    k.outDir = a.out;
+    k.commandLine = commandLine();
+    const KernelBenchResult r = runKernelBench(ctx, compiler, scene, k);
+    std::printf("%s\n%s\nwrote %s\n", r.device.c_str(), kernelTable(r).c_str(), r.mdPath.c_str());
+    return kExitOk;
+  }
   BenchResult r = runBench(ctx, compiler, scene, o);
   std::printf("%s\nwrote %s, %s, %s\n", r.markdown.c_str(), r.mdPath.c_str(), r.csvPath.c_str(), r.svgPath.c_str());
   return kExitOk;
@@ -54,6 +77,16 @@ void addBenchCommand(CLI::App& app, Action& action) {
   cmd->add_flag("--save-images", args->options.saveImages, "also write each method's last measured frame and its reference (EXR)");
   cmd->add_option("--orbit", args->options.orbitDegPerFrame, "moving camera: degrees of orbit per frame");
   cmd->add_option("--device", args->device, "Vulkan device to use (substring of its name)");
+  cmd->add_flag("--kernels", args->kernels,
+                "kernel benchmark instead: marginal ms per image-wide sample, events per second and lane occupancy of "
+                "the path tracer, one ReSTIR iteration and the CPU reference");
+  cmd->add_option("--kernel-spp", args->kernel.spp, "--kernels: samples per run whose times give the slope (default 1 2 4 8)")
+      ->check(CLI::Range(1, 4096));
+  cmd->add_option("--kernel-rounds", args->kernel.rounds, "--kernels: alternating rounds (medians)")->check(CLI::Range(1, 100));
+  cmd->add_option("--kernel-count-spp", args->kernel.countSpp, "--kernels: samples of the counting runs")
+      ->check(CLI::Range(1, 4096));
+  cmd->add_flag("!--no-restir", args->kernel.restir, "--kernels: without ReSTIR");
+  cmd->add_flag("!--no-reference", args->kernel.reference, "--kernels: without the CPU reference");
   addSettingOptions(*cmd, args->overrides);
   cmd->callback([&action, args] { action = [args] { return runBenchCommand(*args); }; });
 }
