@@ -31,15 +31,39 @@ double median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-// Least-squares line y = a + b x: {b, a}.
-std::pair<double, double> fitLine(const std::vector<double>& x, const std::vector<double>& y) {
-  const double n = double(x.size());
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  for (size_t i = 0; i < x.size(); ++i) sx += x[i], sy += y[i], sxx += x[i] * x[i], sxy += x[i] * y[i];
-  const double den = n * sxx - sx * sx;
-  if (x.size() < 2 || den == 0) return {x.empty() || x[0] == 0 ? 0 : y[0] / x[0], 0};
-  const double b = (n * sxy - sx * sy) / den;
-  return {b, (sy - b * sx) / n};
+double quantile(std::vector<double> v, double q) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const double at = q * double(v.size() - 1);
+  const size_t i = size_t(at);
+  return i + 1 < v.size() ? v[i] + (at - double(i)) * (v[i + 1] - v[i]) : v[i];
+}
+
+struct Line {
+  double slope = 0, intercept = 0;
+  double slopeLow = 0, slopeHigh = 0;  // quartiles of the pairwise slopes
+};
+
+// The Theil-Sen line through (x, y): the median of the slopes of all pairs with different x, and
+// the median of y - slope x. Robust to the outliers a loaded machine produces (a run that shared
+// its cores with another process), where least squares is not.
+Line fitLine(const std::vector<double>& x, const std::vector<double>& y) {
+  std::vector<double> slopes;
+  for (size_t i = 0; i < x.size(); ++i)
+    for (size_t j = i + 1; j < x.size(); ++j)
+      if (x[i] != x[j]) slopes.push_back((y[j] - y[i]) / (x[j] - x[i]));
+  Line l;
+  if (slopes.empty()) {
+    if (!x.empty() && x[0] != 0) l.slope = l.slopeLow = l.slopeHigh = y[0] / x[0];
+    return l;
+  }
+  l.slope = median(slopes);
+  l.slopeLow = quantile(slopes, 0.25);
+  l.slopeHigh = quantile(slopes, 0.75);
+  std::vector<double> rest;
+  for (size_t i = 0; i < x.size(); ++i) rest.push_back(y[i] - l.slope * x[i]);
+  l.intercept = median(rest);
+  return l;
 }
 
 double msSince(std::chrono::steady_clock::time_point t0) {
@@ -121,7 +145,8 @@ std::string markdownOf(const KernelBenchResult& r, const Scene& scene, const Ker
              o.rounds, o.countSpp);
   if (!o.commandLine.empty()) md += "```\n" + o.commandLine + "\n```\n\n";
   md += kernelTable(r);
-  md += "\nms/sample: marginal wall ms per image-wide sample (slope of time(k) over k; ReSTIR: per iteration); "
+  md += "\nms/sample: marginal wall ms per image-wide sample (ReSTIR: per iteration), the Theil-Sen slope of "
+        "the wall time of every run against its k (the median of the pairwise slopes; their quartiles beside it); "
         "fixed: the intercept. Events per second = events per image-wide sample / marginal time. Lanes: mean "
         "active lanes per subgroup iteration (of 8 on lavapipe) in the free-flight tracking loops, the "
         "transmittance loops (NEE ratio tracking, ReSTIR's residual ratio tracking), the DDA's segment loop and "
@@ -151,12 +176,12 @@ std::string markdownOf(const KernelBenchResult& r, const Scene& scene, const Ker
 
 std::string kernelTable(const KernelBenchResult& r) {
   std::string t =
-      "| method | ms/sample | fixed ms | M steps/s | M lookups/s | M segments/s | steps/px | lookups/px | "
+      "| method | ms/sample | (quartiles) | fixed ms | M steps/s | M lookups/s | M segments/s | steps/px | lookups/px | "
       "segments/px | lanes: tracking | transmittance | DDA | lookups |\n"
-      "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+      "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const KernelRow& row : r.rows) {
-    t += strf("| %s | %.2f | %.1f | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n", row.method.c_str(),
-              row.msPerSample, row.fixedMs, fmt(row.perSecond(row.total.steps) * 1e-6, "%.1f").c_str(),
+    t += strf("| %s | %.2f | %.2f-%.2f | %.1f | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n", row.method.c_str(),
+              row.msPerSample, row.msPerSampleLow, row.msPerSampleHigh, row.fixedMs, fmt(row.perSecond(row.total.steps) * 1e-6, "%.1f").c_str(),
               fmt(row.perSecond(row.total.lookups) * 1e-6, "%.1f").c_str(),
               fmt(row.perSecond(row.total.segments) * 1e-6, "%.1f").c_str(), fmt(row.total.steps / r.pixels, "%.1f").c_str(),
               fmt(row.total.lookups / r.pixels, "%.1f").c_str(), fmt(row.total.segments / r.pixels, "%.1f").c_str(),
@@ -232,16 +257,19 @@ KernelBenchResult runKernelBench(gpu::Context& ctx, gpu::ShaderCompiler& compile
     methods.push_back(std::move(m));
   }
   LoadedGrid grid;
+  openvdb::FloatGrid::ConstPtr emission;  // loaded once, not at every run
   if (o.reference) {
     ref::checkReferenceSupports(scene);
     const Medium& medium = scene.medium();
     grid = loadFloatGrid(medium.vdbPath(frame), medium.densityGrid);
     grid.clampedValues = clampOpticalDepth(*grid.grid, medium.densityScale);
+    if (medium.emission) emission = loadFloatGrid(medium.vdbPath(frame), medium.emission->grid).grid;
     auto renderRef = [&, frame](int k) {
       Scene s = scene;
       s.render.spp = k;
       ref::ReferenceOptions opt;
       opt.frame = frame;
+      opt.emission = emission;
       opt.progress = false;
       ref::renderReference(s, grid.grid, opt);
     };
@@ -273,14 +301,16 @@ KernelBenchResult runKernelBench(gpu::Context& ctx, gpu::ShaderCompiler& compile
     logInfo(strf("bench --kernels: round %d of %d done", r + 1, o.rounds));
   }
   for (Method& m : methods) {
-    std::vector<double> x;
+    std::vector<double> x, y;  // every run
     for (size_t i = 0; i < o.spp.size(); ++i) {
-      x.push_back(o.spp[i]);
       m.row.medianMs.push_back(median(m.ms[i]));
+      for (double v : m.ms[i]) x.push_back(o.spp[i]), y.push_back(v);
     }
-    const auto [slope, intercept] = fitLine(x, m.row.medianMs);
-    m.row.msPerSample = slope;
-    m.row.fixedMs = intercept;
+    const Line line = fitLine(x, y);
+    m.row.msPerSample = line.slope;
+    m.row.fixedMs = line.intercept;
+    m.row.msPerSampleLow = line.slopeLow;
+    m.row.msPerSampleHigh = line.slopeHigh;
     m.count(m.row);
     result.rows.push_back(m.row);
   }

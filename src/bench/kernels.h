@@ -3,9 +3,9 @@
 //
 // Time: the marginal milliseconds per image-wide sample (one more sample in every pixel) of the
 // path tracer, of one ReSTIR iteration and of the CPU reference — wall time of k samples
-// (iterations) for a few k, alternating methods and k, the median of each (k, method) over the
-// rounds, and the least-squares slope over k, so that fixed costs (a dispatch, clearing the
-// accumulation, the reference's set-up) fall into the intercept.
+// (iterations) for a few k, alternating methods and k over several rounds, and the Theil-Sen slope
+// (median of pairwise slopes, robust on a loaded machine) of time over k, so that fixed costs (a
+// dispatch, clearing the accumulation, the reference's set-up) fall into the intercept.
 // Events: tracking steps, density lookups and DDA segments per image-wide sample, counted by a
 // second build of each estimator's shaders with PLUME_KERNEL_COUNTERS (shared/kernel_counters.h;
 // the timed build has none of it, and both draw the same random numbers) and by the reference's
@@ -27,7 +27,7 @@ namespace plume {
 struct KernelBenchOptions {
   int gridFrame = -1;             // the animation frame whose grid is held still (-1: the scene's first)
   std::vector<int> spp{1, 2, 4, 8};  // the k of time(k): samples (ReSTIR: iterations) per run
-  int rounds = 3;                 // alternating rounds; medians per (method, k)
+  int rounds = 5;                 // alternating rounds (the fit uses every run; the table shows medians per k)
   int countSpp = 2;               // samples (iterations) of the counting runs, one dispatch each
   bool restir = true;             // time and count one ReSTIR iteration (the scene's settings)
   bool reference = true;          // the CPU reference
@@ -45,6 +45,7 @@ struct KernelLoop {
 struct KernelRow {
   std::string method;      // "path tracer", "ReSTIR iteration", "CPU reference"
   double msPerSample = 0;  // the slope: marginal ms per image-wide sample (iteration)
+  double msPerSampleLow = 0, msPerSampleHigh = 0;  // quartiles of the pairwise slopes (the spread)
   double fixedMs = 0;      // the intercept
   std::vector<double> medianMs;  // per k of KernelBenchOptions::spp
   std::vector<KernelLoop> loops;  // loops with events, by tracker
