@@ -1,8 +1,10 @@
 // `plume bench` (issue 4, DESIGN §6) end to end on a tiny image: it builds and caches the
 // reference next to the scene, runs the path tracer curve and the selected ReSTIR variants for a
-// static and a moving camera, and writes a table, a CSV and an SVG whose numbers are sane
-// (finite positive errors and times, the path tracer's error falling with its spp, a finite
-// positive gain for every ReSTIR row: a sanity check, the gains themselves are a benchmark). A second run reuses the cached reference; an edited scene does not.
+// static and a moving camera, and the CPU reference beside them, and writes a table, a CSV and an
+// SVG whose numbers are sane (finite positive errors and times, the path tracer's and the CPU
+// reference's errors falling with their spp, a finite positive gain for every ReSTIR and
+// reference row: a sanity check, the gains themselves are a benchmark). A second run reuses the
+// cached reference; an edited scene does not.
 #include "io/image.h"
 #include "support/test_support.h"
 
@@ -59,7 +61,7 @@ TEST(BenchCli, WritesTableCsvAndPlotWithSaneNumbersAndCachesTheReference) {
   const std::vector<std::string> args = {"bench", (sceneDir / "smoke.json").string(), "-o", (dir / "out").string(),
                                          "--width", "24", "--height", "24", "--ref-spp", "256", "--warmup", "2",
                                          "--measure", "3", "--pt-spp", "1", "4", "--only", "pairwise M4 k3 r16", "R0",
-                                         "--save-images"};
+                                         "--cpu-ref-spp", "1", "16", "--save-images"};
   test::RunResult r = test::runPlume(args);
   ASSERT_EQ(r.exitCode, 0) << r.output;
   const fs::path out = dir / "out";
@@ -69,7 +71,7 @@ TEST(BenchCli, WritesTableCsvAndPlotWithSaneNumbersAndCachesTheReference) {
   const auto rows = csvRows(readText(out / "smoke_bench.csv"));
   ASSERT_GE(rows.size(), 2u);
   int restirRows = 0;
-  std::map<std::string, std::vector<double>> ptErr;
+  std::map<std::string, std::vector<double>> ptErr, cpuErr;
   for (size_t i = 1; i < rows.size(); ++i) {
     ASSERT_EQ(rows[i].size(), 6u) << "row " << i;
     const std::string& cam = rows[i][0];
@@ -80,6 +82,10 @@ TEST(BenchCli, WritesTableCsvAndPlotWithSaneNumbersAndCachesTheReference) {
     EXPECT_TRUE(std::isfinite(err) && err > 0 && err < 10) << method << " relMSE " << err;
     if (method.rfind("pt ", 0) == 0) {
       ptErr[cam].push_back(err);
+    } else if (method.rfind("reference ", 0) == 0) {
+      cpuErr[cam].push_back(err);
+      const double gain = std::stod(rows[i][5]);
+      EXPECT_TRUE(std::isfinite(gain) && gain > 0) << method;
     } else {
       ++restirRows;
       const double gain = std::stod(rows[i][5]);
@@ -91,6 +97,16 @@ TEST(BenchCli, WritesTableCsvAndPlotWithSaneNumbersAndCachesTheReference) {
     ASSERT_EQ(e.size(), 2u);
     EXPECT_LT(e[1], e[0]) << cam << ": 4 spp must beat 1 spp";
   }
+  // The CPU reference is a method row of both cameras; 16 spp against the converged image (another
+  // implementation, another seed) must be well below 1 spp's error (1/16 in expectation).
+  ASSERT_EQ(cpuErr.size(), 2u);
+  for (const auto& [cam, e] : cpuErr) {
+    ASSERT_EQ(e.size(), 2u) << cam;
+    EXPECT_LT(e[1], 0.5 * e[0]) << cam << ": the CPU reference at 16 spp must beat 1 spp";
+  }
+  const std::string md = readText(out / "smoke_bench.md");
+  EXPECT_NE(md.find("| static | reference 16 spp |"), std::string::npos) << md;
+  EXPECT_NE(readText(out / "smoke_bench.svg").find("CPU reference"), std::string::npos);
   const size_t refs = countRefs(sceneDir / "bench_cache");
   EXPECT_GE(refs, 2u);  // static + moving poses
 

@@ -1,5 +1,6 @@
 // plume bench SCENE: error against run time (DESIGN §6): path tracer vs ReSTIR variants at equal
-// GPU time per frame, static and moving camera; markdown table, CSV and SVG plot.
+// GPU time per frame, and the CPU reference beside them, static and moving camera; markdown table,
+// CSV and SVG plot. `--kernels`: the kernel benchmark instead (bench/kernels.h).
 #include "app/commands.h"
 #include "app/settings_cli.h"
 #include "core/error.h"
@@ -20,7 +21,7 @@ struct BenchArgs {
   int width = 64, height = 64;
   BenchOptions options;
   SettingOverrides overrides;
-  bool kernels = false;
+  bool kernels = false, noCpuRef = false;
   KernelBenchOptions kernel;
 };
 
@@ -40,6 +41,7 @@ int runBenchCommand(const BenchArgs& a) {
   if (a.height > 0) scene.camera.height = a.height;
   BenchOptions o = a.options;
   o.outDir = a.out;
+  if (a.noCpuRef) o.cpuRefSpp.clear();
   gpu::Context ctx({a.device, false, true});
   gpu::ShaderCompiler compiler({}, gpu::ShaderCompiler::defaultCacheDir());
   if (a.kernels) {
@@ -70,6 +72,9 @@ void addBenchCommand(CLI::App& app, Action& action) {
   cmd->add_option("--frame", args->options.gridFrame, "animation frame whose grid is held still (default: the scene's first)")
       ->check(CLI::Range(0, 1 << 20));
   cmd->add_option("--ref-spp", args->options.refSpp, "samples per pixel of the cached reference")->check(CLI::Range(16, 1 << 24));
+  cmd->add_option("--cpu-ref-spp", args->options.cpuRefSpp, "the CPU reference's rows: spp per frame (default 1 4 16)")
+      ->check(CLI::Range(1, 1 << 20));
+  cmd->add_flag("--no-cpu-ref", args->noCpuRef, "without the CPU reference's rows");
   cmd->add_option("--pt-spp", args->options.ptSpp, "path tracer spp per frame (its curve)");
   cmd->add_option("--only", args->options.only, "run only the ReSTIR variants whose name contains one of these strings");
   cmd->add_option("--camera", args->options.cameras, "camera runs: static, moving (default both)")

@@ -7,6 +7,8 @@
 #include "core/log.h"
 #include "core/stats.h"
 #include "io/image.h"
+#include "media/vdb_loader.h"
+#include "reference/reference.h"
 #include "render/estimator.h"
 #include "render/volume_source.h"
 #include "scene/render_key.h"
@@ -14,8 +16,10 @@
 #include <glm/glm.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 
@@ -79,6 +83,11 @@ uint64_t referenceKey(const Scene& s, int gridFrame) {
   return fnv1a(render.text() + strf("|%llu|%lld", (unsigned long long)size, (long long)time));
 }
 
+// The converged image's seed; the CPU reference's rows use any other (its pixels' streams would
+// repeat the converged image's noise if the two shared an implementation; they do not, but the
+// error must not depend on that).
+constexpr int kConvergedSeed = 987654321;
+
 // The reference of `frame` (the GPU path tracer at refSpp), cached next to the scene.
 Image loadOrBuildReference(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& s,
                            const GpuVolumeResources& volume, int frame, int refSpp, const std::string& tag) {
@@ -93,7 +102,7 @@ Image loadOrBuildReference(gpu::Context& ctx, gpu::ShaderCompiler& compiler, con
   if (fs::exists(path)) return readExr(path);
   logInfo(strf("bench: building the reference %s (%d spp)", path.c_str(), refSpp));
   Scene rs = s;
-  rs.render.seed = 987654321;
+  rs.render.seed = kConvergedSeed;
   std::unique_ptr<Estimator> pt = makeEstimator(EstimatorKind::PathTracer, ctx, compiler, rs, {.batch = 32});
   pt->setVolumes(volume, nullptr);
   pt->renderFrame(frame, refSpp, {});
@@ -120,7 +129,8 @@ struct Method {
   bool pathTracer = false;  // a point of the path tracer's curve
   int spp = 1;              // per frame (ReSTIR: one iteration)
   std::unique_ptr<Scene> scene;  // its settings; outlives the estimator
-  std::unique_ptr<Estimator> estimator;
+  std::unique_ptr<Estimator> estimator;  // null: the CPU reference (cpuFrame)
+  std::function<Image(int frame)> cpuFrame;
   std::vector<double> ms, err;
   std::map<std::string, std::vector<double>> passMs;
 };
@@ -181,6 +191,16 @@ BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Sce
   const int last = first + o.warmup + o.frames - 1;
   VolumeSource volumes(ctx, scene.medium(), {});
   const GpuVolumeResources& volume = volumes.load(first);
+  // The CPU reference's grids of the same frame, sanitised and clamped as `plume reference` does.
+  openvdb::FloatGrid::ConstPtr cpuGrid, cpuEmission;
+  if (!o.cpuRefSpp.empty()) {
+    ref::checkReferenceSupports(scene);
+    const Medium& medium = scene.medium();
+    LoadedGrid grid = loadFloatGrid(medium.vdbPath(first), medium.densityGrid);
+    clampOpticalDepth(*grid.grid, medium.densityScale);
+    cpuGrid = grid.grid;
+    if (medium.emission) cpuEmission = loadFloatGrid(medium.vdbPath(first), medium.emission->grid).grid;
+  }
 
   for (const bool moving : {false, true}) {
     const std::string cam = moving ? "moving" : "static";
@@ -206,15 +226,38 @@ BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Sce
       add({.name = strf("pt %d spp", spp), .pathTracer = true, .spp = spp}, rs, spp);  // one dispatch per frame
     }
     for (const auto& [name, v] : variants) add({.name = name}, withRestir(s.render, v), 1);
+    for (int spp : o.cpuRefSpp) {
+      Method m{.name = strf("reference %d spp", spp), .spp = spp};
+      m.scene = std::make_unique<Scene>(s);
+      m.scene->render.spp = spp;
+      if (m.scene->render.seed == kConvergedSeed) m.scene->render.seed += 1;
+      const Scene* rs = m.scene.get();
+      m.cpuFrame = [rs, &cpuGrid, &cpuEmission](int f) {
+        ref::ReferenceOptions opt;
+        opt.frame = f;  // the camera and the random streams of frame f, the grid held still
+        opt.emission = cpuEmission;
+        opt.progress = false;
+        return ref::renderReference(*rs, cpuGrid, opt);
+      };
+      methods.push_back(std::move(m));
+    }
     // Alternating: every method renders frame f before any renders f + 1.
     for (int f = first; f <= last; ++f) {
       for (Method& m : methods) {
         const bool warmup = f < first + o.warmup;  // rendered, not read back
-        m.estimator->renderFrame(f, m.spp, {});
-        if (warmup) continue;
-        const Image im = m.estimator->readImage();
+        Image im;
         double ms = 0;
-        for (const auto& [n, t] : m.estimator->lastPassTimes()) ms += t, m.passMs[n].push_back(t);
+        if (m.cpuFrame) {
+          if (warmup) continue;  // no history to settle
+          const auto t0 = std::chrono::steady_clock::now();
+          im = m.cpuFrame(f);
+          ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        } else {
+          m.estimator->renderFrame(f, m.spp, {});
+          if (warmup) continue;
+          im = m.estimator->readImage();
+          for (const auto& [n, t] : m.estimator->lastPassTimes()) ms += t, m.passMs[n].push_back(t);
+        }
         const Image& ref = moving ? refs.at(f) : refs.begin()->second;
         m.ms.push_back(ms);
         m.err.push_back(relMse(im, ref));

@@ -3,6 +3,9 @@
 // reference of that frame's camera pose (cached EXR next to the scene), after a warm-up.
 // The path tracer runs at several spp, which gives its relMSE-against-time curve; each ReSTIR
 // variant's equal-time gain is the ratio of that curve (log-log interpolation) to its relMSE.
+// The CPU reference (src/reference, on the OpenVDB grid itself) runs beside them at several spp,
+// timed by the wall clock, with its own seed (never the converged image's), so the three lie on
+// one axis.
 #pragma once
 
 #include "gpu/context.h"
@@ -21,6 +24,7 @@ struct BenchOptions {
   int gridFrame = -1;      // the animation frame whose grid is held still (-1: the scene's first)
   int refSpp = 2048;       // converged reference (GPU path tracer), >= 16x anything judged
   std::vector<int> ptSpp{1, 2, 4, 8, 16};
+  std::vector<int> cpuRefSpp{1, 4, 16};  // the CPU reference's rows (empty: none)
   std::vector<std::pair<std::string, RestirOptions>> variants;  // empty: a default list
   std::vector<std::string> only;  // non-empty: ReSTIR variants whose name contains one of these
   std::vector<std::string> cameras{"static", "moving"};
@@ -32,9 +36,9 @@ struct BenchOptions {
 struct BenchRow {
   std::string camera;  // "static" | "moving"
   std::string method;
-  double frameMs = 0;  // median GPU time per frame (sum of pass timestamps)
+  double frameMs = 0;  // median GPU time per frame (sum of pass timestamps); the CPU reference: wall time
   double relMse = 0;   // median over measured frames
-  double ptRelMseAtEqualTime = 0;  // path tracer's curve at frameMs (ReSTIR rows)
+  double ptRelMseAtEqualTime = 0;  // path tracer's curve at frameMs (ReSTIR and CPU reference rows)
   double gain = 0;                 // ptRelMseAtEqualTime / relMse
   std::string passTimes;           // median per-pass ms
 };

@@ -28,7 +28,7 @@ std::string svgPlot(const std::vector<BenchRow>& rows, const std::string& title)
   s += strf("<rect width='100%%' height='100%%' fill='white'/><text x='%.0f' y='22' font-size='14'>%s</text>\n", L, title.c_str());
   s += strf("<line x1='%.0f' y1='%.0f' x2='%.0f' y2='%.0f' stroke='black'/>", L, H - B, W - R, H - B);
   s += strf("<line x1='%.0f' y1='%.0f' x2='%.0f' y2='%.0f' stroke='black'/>\n", L, T, L, H - B);
-  s += strf("<text x='%.0f' y='%.0f'>GPU time per frame (ms, log)</text>", L + 150, H - 20);
+  s += strf("<text x='%.0f' y='%.0f'>time per frame (ms, log; GPU timestamps, CPU reference: wall)</text>", L + 60, H - 20);
   s += strf("<text x='12' y='%.0f' transform='rotate(-90 12 %.0f)'>relMSE (log)</text>\n", H / 2 + 40, H / 2 + 40);
   for (int e = int(std::floor(std::log10(ymin / 1.5))); e <= int(std::ceil(std::log10(ymax * 1.5))); ++e) {
     const double v = std::pow(10.0, e);
@@ -43,26 +43,31 @@ std::string svgPlot(const std::vector<BenchRow>& rows, const std::string& title)
     }
   }
   const char* colours[] = {"#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf", "#8c564b", "#e377c2", "#bcbd22"};
-  for (const char* cam : {"static", "moving"}) {
-    std::string line;
-    for (const auto& r : rows)
-      if (r.camera == cam && r.method.rfind("pt ", 0) == 0) line += strf("%.1f,%.1f ", X(r.frameMs), Y(r.relMse));
-    if (!line.empty())
-      s += strf("<polyline points='%s' fill='none' stroke='black' %s/>\n", line.c_str(),
-                std::string(cam) == "moving" ? "stroke-dasharray='4 3'" : "");
+  const char* cpuColour = "#1f77b4";
+  // The path tracer's and the CPU reference's points are curves (one method at several spp).
+  for (const auto& [prefix, colour] : {std::pair{"pt ", "black"}, std::pair{"reference ", cpuColour}}) {
+    for (const char* cam : {"static", "moving"}) {
+      std::string line;
+      for (const auto& r : rows)
+        if (r.camera == cam && r.method.rfind(prefix, 0) == 0) line += strf("%.1f,%.1f ", X(r.frameMs), Y(r.relMse));
+      if (!line.empty())
+        s += strf("<polyline points='%s' fill='none' stroke='%s' %s/>\n", line.c_str(), colour,
+                  std::string(cam) == "moving" ? "stroke-dasharray='4 3'" : "");
+    }
   }
   int legend = 0;
   std::map<std::string, int> colourOf;
   for (const auto& r : rows) {
     const bool pt = r.method.rfind("pt ", 0) == 0;
-    const std::string key = pt ? "path tracer" : r.method;
-    if (!colourOf.count(key)) colourOf[key] = int(colourOf.size());
-    const char* c = pt ? "black" : colours[colourOf[key] % 8];
+    const bool cpu = r.method.rfind("reference ", 0) == 0;
+    const std::string key = pt ? "path tracer" : cpu ? "CPU reference" : r.method;
+    if (!colourOf.count(key)) colourOf[key] = pt || cpu ? -1 : int(std::count_if(colourOf.begin(), colourOf.end(), [](const auto& e) { return e.second >= 0; }));
+    const char* c = pt ? "black" : cpu ? cpuColour : colours[colourOf[key] % 8];
     if (r.camera == "static") s += strf("<circle cx='%.1f' cy='%.1f' r='4' fill='%s'/>", X(r.frameMs), Y(r.relMse), c);
     else s += strf("<rect x='%.1f' y='%.1f' width='7' height='7' fill='none' stroke='%s'/>", X(r.frameMs) - 3.5, Y(r.relMse) - 3.5, c);
   }
   for (const auto& [key, i] : colourOf) {
-    const char* c = key == "path tracer" ? "black" : colours[i % 8];
+    const char* c = key == "path tracer" ? "black" : key == "CPU reference" ? cpuColour : colours[i % 8];
     s += strf("<circle cx='%.0f' cy='%.0f' r='4' fill='%s'/><text x='%.0f' y='%.0f'>%s</text>\n", W - R + 15, T + 16.0 * legend, c,
               W - R + 24, T + 16.0 * legend + 4, key.c_str());
     ++legend;
@@ -75,10 +80,12 @@ std::string svgPlot(const std::vector<BenchRow>& rows, const std::string& title)
 
 void writeBenchReport(BenchResult& result, const Scene& scene, const BenchOptions& o, int first, const std::string& dir) {
   std::string md = strf("Device: %s. Scene: %s, %dx%d, max_bounces %d, the grid of frame %d held still. Warm-up %d "
-                        "frames, %d measured; medians. Reference: GPU path tracer, %d spp (own relMSE <= %.2g).\n\n",
+                        "frames, %d measured; medians. Converged image: GPU path tracer, %d spp (own relMSE <= %.2g). ms/frame: GPU "
+                        "timestamps; the CPU reference's rows (`reference N spp`, its own seed): wall time, on the "
+                        "host's cores.\n\n",
                         result.device.c_str(), scene.path.c_str(), scene.camera.width, scene.camera.height,
                         scene.render.maxBounces, first, o.warmup, o.frames, o.refSpp, result.referenceRelMse);
-  md += "| camera | method | GPU ms/frame | relMSE | PT relMSE at equal time | gain vs PT | per-pass ms |\n";
+  md += "| camera | method | ms/frame | relMSE | PT relMSE at equal time | gain vs PT | per-pass ms |\n";
   md += "|---|---|---|---|---|---|---|\n";
   std::string csv = "camera,method,frame_ms,relmse,pt_relmse_equal_time,gain\n";
   for (const BenchRow& r : result.rows) {
