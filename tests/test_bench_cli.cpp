@@ -135,3 +135,41 @@ TEST(BenchCli, AnUnknownVariantIsABadInput) {
   EXPECT_EQ(r.exitCode, 2) << r.output;
   EXPECT_NE(r.output.find("--only"), std::string::npos) << r.output;
 }
+
+// `plume bench --kernels` on a tiny image: a row per method with a marginal cost, the
+// device's events and lane occupancy within [1, 8] (lavapipe's subgroups; any device: [1, 128]),
+// the reference's events but no lanes, and the markdown file.
+TEST(BenchCli, KernelBenchmarkReportsEveryMethod) {
+  const fs::path out = test::outputDir("bench_cli_kernels");
+  test::RunResult r = test::runPlume({"bench", test::sourcePath("volumes/smoke/smoke.json"), "--kernels", "--frame", "12",
+                                      "--width", "16", "--height", "16", "--kernel-spp", "1", "2", "--kernel-rounds", "1",
+                                      "--kernel-count-spp", "1", "-o", out.string()});
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  const std::string md = readText(out / "smoke_kernels_16x16.md");
+  for (const char* method : {"| path tracer |", "| ReSTIR iteration |", "| CPU reference |"}) {
+    const size_t at = md.find(method);
+    ASSERT_NE(at, std::string::npos) << method << "\n" << md;
+    // | method | ms/sample | quartiles | fixed | steps/s | lookups/s | segments/s | steps/px | lookups/px |
+    // segments/px | lanes: tracking | transmittance | DDA | lookups |
+    std::vector<std::string> cells;
+    std::stringstream line(md.substr(at + 1, md.find('\n', at) - at - 1));
+    std::string cell;
+    while (std::getline(line, cell, '|')) cells.push_back(cell.substr(cell.find_first_not_of(' ')));
+    ASSERT_GE(cells.size(), 14u) << method;
+    // Timings at 16² on a loaded machine may even come out negative: a number, not a benchmark here.
+    EXPECT_TRUE(std::isfinite(std::stod(cells[1]))) << method << ": ms per sample";
+    const double steps = std::stod(cells[7]), lookups = std::stod(cells[8]), segments = std::stod(cells[9]);
+    EXPECT_GT(steps, 0.0) << method;
+    EXPECT_GT(lookups, 0.0) << method;
+    EXPECT_LE(lookups, steps) << method;
+    EXPECT_LE(steps, lookups + segments + 0.1) << method;  // rounded to 0.1 in the table
+    const bool cpu = std::string(method) == "| CPU reference |";
+    const double dda = cpu ? 0 : std::stod(cells[12]);
+    if (cpu) {
+      EXPECT_EQ(cells[12].rfind("—", 0), 0u) << "the reference is scalar: no lanes";
+    } else {
+      EXPECT_GE(dda, 1.0) << method;
+      EXPECT_LE(dda, 8.0) << method;
+    }
+  }
+}
