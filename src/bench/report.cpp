@@ -56,12 +56,13 @@ std::string svgPlot(const std::vector<BenchRow>& rows, const std::string& title)
     }
   }
   int legend = 0;
-  std::map<std::string, int> colourOf;
+  std::map<std::string, int> colourOf;  // ReSTIR variants: their colour's index; the two curves: -1
+  int variantColours = 0;
   for (const auto& r : rows) {
     const bool pt = r.method.rfind("pt ", 0) == 0;
     const bool cpu = r.method.rfind("reference ", 0) == 0;
     const std::string key = pt ? "path tracer" : cpu ? "CPU reference" : r.method;
-    if (!colourOf.count(key)) colourOf[key] = pt || cpu ? -1 : int(std::count_if(colourOf.begin(), colourOf.end(), [](const auto& e) { return e.second >= 0; }));
+    if (!colourOf.count(key)) colourOf[key] = pt || cpu ? -1 : variantColours++;
     const char* c = pt ? "black" : cpu ? cpuColour : colours[colourOf[key] % 8];
     if (r.camera == "static") s += strf("<circle cx='%.1f' cy='%.1f' r='4' fill='%s'/>", X(r.frameMs), Y(r.relMse), c);
     else s += strf("<rect x='%.1f' y='%.1f' width='7' height='7' fill='none' stroke='%s'/>", X(r.frameMs) - 3.5, Y(r.relMse) - 3.5, c);
