@@ -135,10 +135,14 @@ struct Method {
   std::map<std::string, std::vector<double>> passMs;
 };
 
-// log-log interpolation of the path tracer's (ms, relMSE) points at `ms`.
+// log-log interpolation of the path tracer's (ms, relMSE) points at `ms`; outside their range, the
+// nearest end point's relMSE scaled by 1/time (an unbiased estimator's error at a proportional
+// number of samples), not the end segment's slope, which the noise of two close points can make
+// anything (the CPU reference's fast rows lie there).
 double ptCurveAt(const std::vector<std::pair<double, double>>& pts, double ms) {
   if (pts.empty()) return 0;
-  if (pts.size() == 1) return pts[0].second * pts[0].first / ms;
+  if (ms <= pts.front().first) return pts.front().second * pts.front().first / ms;
+  if (ms >= pts.back().first) return pts.back().second * pts.back().first / ms;
   size_t i = 0;
   while (i + 2 < pts.size() && pts[i + 1].first < ms) ++i;
   const double x0 = std::log(pts[i].first), x1 = std::log(pts[i + 1].first);
@@ -281,6 +285,7 @@ BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Sce
       row.relMse = median(m.err);
       if (!m.pathTracer) {
         row.ptRelMseAtEqualTime = ptCurveAt(curve, row.frameMs);
+        row.outsidePtRange = !curve.empty() && (row.frameMs < curve.front().first || row.frameMs > curve.back().first);
         row.gain = row.relMse > 0 ? row.ptRelMseAtEqualTime / row.relMse : 0;
       }
       for (const auto& [n, t] : m.passMs) row.passTimes += strf("%s%s %.1f", row.passTimes.empty() ? "" : ", ", n.c_str(), median(t));

@@ -40,6 +40,7 @@ struct BenchRow {
   double relMse = 0;   // median over measured frames
   double ptRelMseAtEqualTime = 0;  // path tracer's curve at frameMs (ReSTIR and CPU reference rows)
   double gain = 0;                 // ptRelMseAtEqualTime / relMse
+  bool outsidePtRange = false;     // frameMs outside the path tracer's measured times (extrapolated by 1/time)
   std::string passTimes;           // median per-pass ms
 };
 

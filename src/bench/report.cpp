@@ -92,11 +92,14 @@ void writeBenchReport(BenchResult& result, const Scene& scene, const BenchOption
   for (const BenchRow& r : result.rows) {
     const bool pt = r.method.rfind("pt ", 0) == 0;
     md += strf("| %s | %s | %.1f | %.4g | %s | %s | %s |\n", r.camera.c_str(), r.method.c_str(), r.frameMs, r.relMse,
-               pt ? "" : strf("%.4g", r.ptRelMseAtEqualTime).c_str(), pt ? "" : strf("%.2fx", r.gain).c_str(),
+               pt ? "" : strf("%.4g%s", r.ptRelMseAtEqualTime, r.outsidePtRange ? "*" : "").c_str(),
+               pt ? "" : strf("%.2fx", r.gain).c_str(),
                r.passTimes.c_str());
     csv += strf("%s,%s,%.4f,%.6g,%.6g,%.4f\n", r.camera.c_str(), r.method.c_str(), r.frameMs, r.relMse,
                 r.ptRelMseAtEqualTime, r.gain);
   }
+  if (std::any_of(result.rows.begin(), result.rows.end(), [](const BenchRow& r) { return r.outsidePtRange; }))
+    md += "\n\\* outside the path tracer's measured times: its nearest point's relMSE scaled by 1/time.\n";
   result.markdown = md;
   const std::string stem = fs::path(scene.path).stem().string();
   result.mdPath = (fs::path(dir) / (stem + "_bench.md")).string();
