@@ -15,6 +15,7 @@
 #include "render/restir.h"
 #include "shaders/shared/kernel_counters.h"
 #include "support/gpu_fixture.h"
+#include "support/kernel_counters.h"
 #include "support/grids.h"
 #include "support/scenes.h"
 
@@ -25,37 +26,13 @@
 
 using namespace plume;
 namespace sh = plume::shared;
+using test::bakeOf;
+using test::expectPlausible;
+using test::kernelWords;
+using test::smallScene;
+using namespace test::kc;
 
 namespace {
-
-Scene smallScene(int size, int maxBounces) {
-  Scene s;
-  s.path = "test-scene";
-  s.camera.base.position = {0.5f, 0.6f, 2.2f};
-  s.camera.base.lookAt = {0.5f, 0.5f, 0.5f};
-  s.camera.base.fovY = 40.0f;
-  s.camera.width = s.camera.height = size;
-  Medium m;
-  m.densityScale = 6.0f;
-  s.media.push_back(m);
-  s.lights = {test::sunLight({0.4f, 1.0f, 0.3f}, {3.0f, 2.8f, 2.5f}), test::skyLight({0.10f, 0.12f, 0.16f})};
-  s.render.maxBounces = maxBounces;
-  s.render.spp = 4;
-  return s;
-}
-
-BakedVolume bakeOf(openvdb::FloatGrid::Ptr grid) {
-  LoadedGrid loaded;
-  loaded.grid = grid;
-  loaded.name = "density";
-  return bakeVolume(loaded);
-}
-
-// The kernel counter words of a run (the buffer's words from KC_BASE on).
-std::vector<uint32_t> kernelWords(const GpuVolumeResources& volume) {
-  std::vector<uint32_t> w = volume.counterWords();
-  return std::vector<uint32_t>(w.begin() + sh::KC_BASE, w.end());
-}
 
 class KernelCounters : public test::GpuTest {
  protected:
@@ -71,28 +48,6 @@ class KernelCounters : public test::GpuTest {
     return tracer.readImage();
   }
 };
-
-// The relations every tracker's block must satisfy (see the top of the file).
-void expectPlausible(const std::vector<uint32_t>& w, const std::string& what) {
-  for (uint32_t t = 0; t < sh::KC_TRACKERS; ++t) {
-    const uint32_t* c = &w[t * sh::KC_PER_TRACKER];
-    SCOPED_TRACE(what + ", tracker " + std::to_string(t));
-    EXPECT_LE(c[sh::KC_LOOKUPS], c[sh::KC_STEPS]);
-    EXPECT_LE(c[sh::KC_STEPS], uint64_t(c[sh::KC_LOOKUPS]) + c[sh::KC_SEGMENTS]);
-    // Lanes per subgroup iteration: at least one (an iteration is counted only with a lane
-    // active) and at most the subgroup size (8 on lavapipe; no device has more than 128).
-    for (auto [lanes, iters] : {std::pair{sh::KC_SEGMENTS, sh::KC_SEGMENT_ITERS}, std::pair{sh::KC_STEPS, sh::KC_STEP_ITERS},
-                                std::pair{sh::KC_LOOKUPS, sh::KC_LOOKUP_ITERS}}) {
-      EXPECT_LE(c[iters], c[lanes]);
-      EXPECT_LE(c[lanes], 128ull * c[iters]);
-    }
-    if (c[sh::KC_WALKS] == 0) {
-      EXPECT_EQ(c[sh::KC_SEGMENTS], 0u);
-    }
-  }
-}
-
-const uint32_t kDelta = 0, kRatio = 1, kResidual = 2;  // VOL_TRACK_* of shaders/volume/walk.glsl
 
 }  // namespace
 
@@ -136,6 +91,34 @@ TEST_F(KernelCounters, RestirImageIsBitIdenticalAndCountsArePlausible) {
   EXPECT_EQ(words[0], std::vector<uint32_t>(words[0].size(), 0u));
   expectPlausible(words[1], "restir");
   EXPECT_GT(words[1][kResidual * sh::KC_PER_TRACKER + sh::KC_LOOKUPS], 0u);  // final shading's transmittance
+}
+
+// The emitting trackers are copies of the walk of their own: the same holds there (delta tracking
+// with emission here; ReSTIR's ratio tracking with emission in test_kernel_counters_slow.cpp).
+TEST_F(KernelCounters, EmittingMediumImagesAreBitIdentical) {
+  Scene s = smallScene(12, 3);
+  s.media[0].albedo = glm::vec3(0.5f);
+  Emission e;
+  e.grid = "emission";
+  e.scale = 2.0f;
+  e.color = {1.0f, 0.5f, 0.25f};
+  s.media[0].emission = e;
+  LoadedGrid density, emission;
+  density.grid = test::makeNoiseGrid(24, 1.0 / 24);
+  density.name = "density";
+  emission.grid = test::makeNoiseGrid(24, 1.0 / 24, 5);
+  emission.name = "emission";
+  BakedVolume bake = bakeVolume(density);
+  bakeEmission(bake, density, emission);
+  GpuVolumeResources volume(ctx(), bake, s.media[0].densityScale, &*s.media[0].emission);
+  std::vector<uint32_t> plain, counted;
+  const Image a = renderPt(s, volume, false, &plain);
+  const Image b = renderPt(s, volume, true, &counted);
+  EXPECT_EQ(a.rgb, b.rgb);
+  EXPECT_EQ(plain, std::vector<uint32_t>(plain.size(), 0u));
+  expectPlausible(counted, "path tracer, emission");
+  EXPECT_GT(counted[kDeltaEmit * sh::KC_PER_TRACKER + sh::KC_LOOKUPS], 0u);
+
 }
 
 TEST_F(KernelCounters, EmptyGridHasNoTrackingSteps) {
