@@ -16,6 +16,7 @@
 #include "shared/gpu_types.h"
 #include "shared/restir_types.h"
 #include "shared/bindings.h"
+#include "shared/bvh.h"
 
 // restir_mis.h reads its inputs through accessor macros (here: small tables).
 float misM[3];
@@ -52,6 +53,11 @@ layout(std430, binding = 4) readonly buffer BlackbodyBuffer {
 };
 #define BB_TABLE(i) bbTable[i].rgb
 #include "shared/blackbody.h"
+// bvh.h: the layout only (surface/bvh.glsl traverses it; shaders/tests/bvh_kernels.comp runs it).
+layout(std430, binding = 5) readonly buffer BvhBuffer {
+  BvhNode bvhNodes[2];
+  BvhTriangle bvhTriangles[];
+};
 
 void main() {
   uint i = gl_GlobalInvocationID.x;
@@ -121,6 +127,15 @@ void main() {
   // blackbody.h
   s += bb_lookup(1000.0f + 9000.0f * u.x) * bb_table_kelvin(i % BB_TABLE_SIZE) * BB_TABLE_MAX_K * BB_TABLE_MIN_K +
        vec3(float(BIND_BLACKBODY + BIND_EMISSION_ATLAS + BIND_PREV_EMISSION_ATLAS + EMISSION_BINDING_COUNT));
+  // bvh.h
+  BvhNode bn = bvhNodes[0];
+  BvhTriangle bt = bvhTriangles[bn.ref0 % 2u];
+  BvhHit bh;
+  bh.t = bn.lo1.x + bn.hi0.y;
+  bh.prim = bt.prim + bn.count0 + bn.count1 + bn.ref1 + BVH_NONE + BVH_MAX_LEAF_SIZE + uint(BVH_MAX_DEPTH + BVH_STACK_SIZE);
+  bh.u = bt.v1.x;
+  bh.v = bt.v2.y;
+  s += bn.hi1 + bt.v0 + vec3(bh.t, float(bh.prim), bh.u + bh.v);
   values[i] = vec4(s + wo, t + m + (picked ? 1.0f : 0.0f) + (dropped ? 2.0f : 0.0f) +
                    (rs_is_finite(back.W) ? back.W : 0.0f));
 }
