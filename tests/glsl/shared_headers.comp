@@ -17,6 +17,7 @@
 #include "shared/restir_types.h"
 #include "shared/bindings.h"
 #include "shared/bvh.h"
+#include "shared/bsdf.h"
 
 // restir_mis.h reads its inputs through accessor macros (here: small tables).
 float misM[3];
@@ -136,6 +137,18 @@ void main() {
   bh.u = bt.v1.x;
   bh.v = bt.v2.y;
   s += bn.hi1 + bt.v0 + vec3(bh.t, float(bh.prim), bh.u + bh.v);
+  // bsdf.h
+  Bsdf bsdf;
+  bsdf.color = vec3(0.5f);
+  bsdf.type = i % 2u == 0u ? BSDF_DIFFUSE : BSDF_CONDUCTOR;
+  bsdf.alpha = 0.3f;
+  bsdf.pad0 = bsdf.pad1 = bsdf.pad2 = 0.0f;
+  vec3 bwi;
+  float bpdf;
+  s += bsdf_sample(bsdf, wo, u, bwi, bpdf) * bpdf + bsdf_eval(bsdf, wo, bwi) * bsdf_pdf(bsdf, wo, bwi) +
+       bsdf_schlick(vec3(0.04f), u.x) * (bsdf_ggx_d(wo, 0.2f) + bsdf_ggx_g1(wo, 0.2f) + bsdf_ggx_g2(wo, bwi, 0.2f)) +
+       bsdf_ggx_eval(vec3(1.0f), 0.1f, wo, bwi) * (bsdf_ggx_pdf(0.1f, wo, bwi) + bsdf_lambert_pdf(wo, bwi) + bsdf_alpha(bsdf)) +
+       bsdf_lambert_sample(wo, u) + bsdf_ggx_sample_vndf(wo, 0.3f, u) * bsdf_ggx_lambda(wo, 0.3f) + vec3(BSDF_MIN_ALPHA);
   values[i] = vec4(s + wo, t + m + (picked ? 1.0f : 0.0f) + (dropped ? 2.0f : 0.0f) +
                    (rs_is_finite(back.W) ? back.W : 0.0f));
 }
