@@ -292,6 +292,9 @@ FlatBvh buildBvh(const TriangleMesh& mesh, const BvhOptions& options) {
   out.stats.nodes = out.nodes.size();
   out.stats.references = out.triangles.size();
   out.stats.bytes = out.nodes.size() * sizeof(sh::BvhNode) + out.triangles.size() * sizeof(sh::BvhTriangle);
+  // The traversal packs a child reference with its count in one word (ref << 3 | count).
+  if (out.triangles.size() >= (size_t(1) << 29) || out.nodes.size() >= (size_t(1) << 29))
+    throw InputError("the surfaces hold " + std::to_string(out.triangles.size()) + " triangle references, more than the 2^29 the BVH layout addresses");
   if (out.stats.depth > sh::BVH_STACK_SIZE)
     throw InputError("the surfaces' BVH is " + std::to_string(out.stats.depth) + " levels deep, more than the " +
                      std::to_string(sh::BVH_STACK_SIZE) + " the shaders' traversal stack holds");

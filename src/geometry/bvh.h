@@ -39,7 +39,8 @@ struct BvhOptions {
 
 // Builds with Embree's rtcBuildBVH (RTC_BUILD_QUALITY_HIGH: binned SAH, with spatial splits when
 // enabled), binary, at most BVH_MAX_LEAF_SIZE triangles a leaf. Throws InputError when the tree
-// is deeper than the shader's traversal stack, InternalError or DeviceError when Embree fails.
+// is deeper than the shader's traversal stack or holds 2^29 or more triangle references,
+// InternalError or DeviceError when Embree fails.
 FlatBvh buildBvh(const TriangleMesh& mesh, const BvhOptions& options = {});
 
 // An Embree scene of one triangle mesh (primID = triangle index), built with
