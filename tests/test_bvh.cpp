@@ -135,12 +135,21 @@ TEST(Bvh, EmptyAndSingleLeafTrees) {
   EXPECT_EQ(empty.nodes[0].ref0, sh::BVH_NONE);
   EXPECT_EQ(empty.nodes[0].ref1, sh::BVH_NONE);
   EXPECT_TRUE(empty.triangles.empty());
+  const geo::EmbreeScene none{geo::TriangleMesh{}};
+  EXPECT_EQ(none.intersect(glm::vec3(0.0f), glm::vec3(0, 0, 1), 0.0f, 1e30f).prim, sh::BVH_NONE);
+  EXPECT_FALSE(none.occluded(glm::vec3(0.0f), glm::vec3(0, 0, 1), 0.0f, 1e30f));
   const geo::TriangleMesh plane = geo::makePlane(glm::vec3(0.0f), glm::vec3(0, 0, 1), glm::vec2(1.0f, 2.0f), "plane");
   const geo::FlatBvh one = geo::buildBvh(plane);
   ASSERT_EQ(one.nodes.size(), 1u);
   EXPECT_EQ(one.nodes[0].count0, 2u);
   EXPECT_EQ(one.nodes[0].ref1, sh::BVH_NONE);
   checkTree(plane, one, false);
+  const geo::EmbreeScene embree(plane);  // the plane faces +Z at the origin, 1 x 2
+  const sh::BvhHit hit = embree.intersect(glm::vec3(0.1f, 0.2f, 2.0f), glm::vec3(0, 0, -1), 0.0f, 1e30f);
+  EXPECT_FLOAT_EQ(hit.t, 2.0f);
+  EXPECT_NE(hit.prim, sh::BVH_NONE);
+  EXPECT_TRUE(embree.occluded(glm::vec3(0.1f, 0.2f, -2.0f), glm::vec3(0, 0, 1), 0.0f, 3.0f)) << "both sides";
+  EXPECT_FALSE(embree.occluded(glm::vec3(0.1f, 0.2f, -2.0f), glm::vec3(0, 0, 1), 0.0f, 1.5f)) << "tMax";
 }
 
 TEST(Mesh, GeneratedMeshesFaceOutwards) {

@@ -312,6 +312,11 @@ EmbreeScene::EmbreeScene(const TriangleMesh& mesh) : impl_(std::make_unique<Impl
   impl_->scene = rtcNewScene(dev);
   rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);
   rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_HIGH);
+  if (mesh.triangles.empty()) {  // an empty scene: every ray misses
+    rtcCommitScene(impl_->scene);
+    throwOnEmbreeError("rtcCommitScene");
+    return;
+  }
   RTCGeometry geom = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
   auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                                          3 * sizeof(float), std::max<size_t>(mesh.positions.size(), 1)));
