@@ -5,6 +5,7 @@
 // renders them (issue 12; the CLI side is in tests/bad_inputs/cases.json).
 #include "core/error.h"
 #include "geometry/mesh.h"
+#include "geometry/scene_mesh.h"
 #include "scene/scene.h"
 #include "support/test_support.h"
 
@@ -23,6 +24,9 @@ std::string sceneDir() {
   static const std::string dir = [] {
     const std::string d = test::outputDir("scene_surfaces");
     std::ofstream(d + "/ground.obj") << "v -1 0 1\nv 1 0 1\nv 1 0 -1\nv -1 0 -1\nf 1 2 3 4\n";
+    std::ofstream(d + "/sliver.obj") << "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\nf 1 1 4\n";
+    std::ofstream(d + "/empty.obj") << "# nothing\nv 0 0 0\n";
+    std::ofstream(d + "/broken.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n";
     return d;
   }();
   return dir;
@@ -67,6 +71,7 @@ TEST(SceneSurfaces, ParsesEveryForm) {
   EXPECT_TRUE(s.surfaces[1].obj.empty());
   EXPECT_EQ(s.surfaces[1].plane->normal, glm::vec3(0, 1, 0));  // normalised
   EXPECT_EQ(s.surfaces[1].plane->size, glm::vec2(4, 5));
+  EXPECT_EQ(s.surfaces[1].plane->center, glm::vec3(1, 2, 3));
   EXPECT_EQ(s.surfaces[1].material, SurfaceMaterial::Conductor);
   EXPECT_FLOAT_EQ(s.surfaces[1].roughness, 0.3f);
   EXPECT_EQ(s.surfaces[1].f0, glm::vec3(0.9f, 0.6f, 0.2f));
@@ -123,4 +128,40 @@ TEST(SceneSurfaces, RefusedUntilRendered) {
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()), "scene.json: surfaces: surfaces are parsed but not yet rendered (issue 12)");
   }
+}
+
+TEST(SceneSurfaces, LoadedIntoOneWorldSpaceMesh) {
+  const Scene s = parse(json::parse(R"([
+    {"plane": {"center": [0, 1, 0], "size": 2}},
+    {"obj": "ground.obj", "transform": {"translate": [0, 5, 0], "scale": 2}},
+    {"obj": "sliver.obj", "material": "conductor", "roughness": 0.2, "f0": [1, 1, 1]}
+  ])"));
+  const geo::SceneMesh m = geo::loadSceneSurfaces(s);
+  ASSERT_EQ(m.mesh.triangles.size(), 2u + 2u + 1u);
+  EXPECT_EQ(m.triangleSurface, (std::vector<uint32_t>{0, 0, 1, 1, 2}));
+  EXPECT_EQ(m.degenerate, (std::vector<size_t>{0, 0, 2}));
+  // The OBJ quad, scaled by 2 and lifted by 5: its corners at (+-2, 5, +-2).
+  for (size_t t = 2; t < 4; ++t)
+    for (int k = 0; k < 3; ++k) {
+      const glm::vec3 p = m.mesh.positions[m.mesh.triangles[t][k]];
+      EXPECT_FLOAT_EQ(std::abs(p.x), 2.0f);
+      EXPECT_FLOAT_EQ(p.y, 5.0f);
+      EXPECT_FLOAT_EQ(std::abs(p.z), 2.0f);
+    }
+  // The plane at y = 1 facing +Y.
+  for (int k = 0; k < 3; ++k) EXPECT_FLOAT_EQ(m.mesh.positions[m.mesh.triangles[0][k]].y, 1.0f);
+}
+
+TEST(SceneSurfaces, LoadErrorsNameTheFileOrTheKey) {
+  auto loadError = [](const char* text) -> std::string {
+    try {
+      geo::loadSceneSurfaces(parse(json::parse(text)));
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  EXPECT_EQ(loadError(R"([{"obj": "broken.obj"}])"), sceneDir() + "/broken.obj:4: position index 4 out of range (3 positions defined so far)");
+  EXPECT_EQ(loadError(R"([{"plane": {"size": 1}}, {"obj": "empty.obj"}])"), "scene.json: surfaces[1]: no triangles (" + sceneDir() + "/empty.obj)");
+  EXPECT_EQ(loadError(R"([{"obj": "ground.obj"}])"), "");
 }
