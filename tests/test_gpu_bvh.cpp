@@ -20,6 +20,7 @@
 
 #include <glm/glm.hpp>
 
+#include <chrono>
 #include <cmath>
 #include <functional>
 #include <iomanip>
@@ -197,6 +198,7 @@ struct Tally {
 
 class GpuBvh : public test::GpuTest {
  protected:
+  double traceMs = 0.0;  // the last trace's submit-to-finish time (closest + any hit per ray)
   std::vector<RayResult> trace(const geo::FlatBvh& bvh, const std::vector<RayCase>& rays) {
     using gpu::BindingType;
     gpu::ComputePass pass(ctx(), compiler().compile("tests/bvh_kernels.comp", {}),
@@ -215,7 +217,9 @@ class GpuBvh : public test::GpuTest {
     pass.set.bind(2, in);
     pass.set.bind(3, out);
     const uint32_t count = uint32_t(rays.size());
+    const auto t0 = std::chrono::steady_clock::now();
     ctx().submitAndWait([&](VkCommandBuffer cmd) { pass.record(cmd, glm::uvec3(count, 1, 1), &count); });
+    traceMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     std::vector<RayResult> results(rays.size());
     out.download(results.data(), results.size() * sizeof(RayResult));
     return results;
@@ -344,11 +348,11 @@ TEST_F(GpuBvh, ShaderTraversalEqualsEmbree) {
       total += tally.rays;
       std::printf("[ bvh ] %-6s%s %6zu triangles: build %.2f ms (+ flatten %.2f ms), %zu nodes, %zu references, depth %d, "
                   "%.1f bytes/triangle on the device | %d rays, %d hits, ties: %d triangle, %d edge, %d any, %d coplanar "
-                  "(%d among random rays); %d spurious Embree hits; worst |dt|/tol %.3f\n",
+                  "(%d among random rays); %d spurious Embree hits; worst |dt|/tol %.3f; traced in %.1f ms\n",
                   mc.name.c_str(), splits ? "" : " (no splits)", bvh.stats.inputTriangles, bvh.stats.buildMs, bvh.stats.flattenMs,
                   bvh.stats.nodes, bvh.stats.references, bvh.stats.depth, bvh.stats.bytesPerTriangle(), tally.rays, tally.hits,
                   tally.primTies, tally.edgeTies, tally.anyTies, tally.coplanarTies, tally.randomTies, tally.embreeSpurious,
-                  tally.worstTRatio);
+                  tally.worstTRatio, traceMs);
       EXPECT_EQ(tally.closestMismatch, 0) << mc.name << "\n" << tally.log.str();
       EXPECT_EQ(tally.baryMismatch, 0) << mc.name << "\n" << tally.log.str();
       EXPECT_EQ(tally.anyMismatch, 0) << mc.name << "\n" << tally.log.str();
