@@ -36,6 +36,7 @@ std::string commandLine() {
 
 int runBenchCommand(const BenchArgs& a) {
   Scene scene = loadScene(a.scene);
+  refuseSurfaces(scene);
   applyOverrides(scene.render, a.overrides);
   if (a.width > 0) scene.camera.width = a.width;
   if (a.height > 0) scene.camera.height = a.height;

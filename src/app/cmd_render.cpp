@@ -101,6 +101,7 @@ int renderFrames(const RenderArgs& a, const Scene& scene, gpu::Context& ctx, Est
 
 int runRender(const RenderArgs& a) {
   Scene scene = loadJobScene(a);
+  refuseSurfaces(scene);
   const RenderSettings& rs = scene.render;
   const EstimatorKind kind = estimatorKind(rs);
   const EstimatorTraits& traits = estimatorTraits(kind);

@@ -21,6 +21,7 @@ struct ViewArgs {
 int runView(ViewArgs& a) {
   setQuiet(a.options.quiet);
   Scene scene = loadScene(a.scene);
+  refuseSurfaces(scene);
   applyOverrides(scene.render, a.overrides);
   if (a.width > 0) scene.camera.width = a.width;
   if (a.height > 0) scene.camera.height = a.height;

@@ -213,9 +213,7 @@ Ray cameraRay(const CameraFrame& f, const Camera& cam, int px, int py, double u,
 }  // namespace
 
 void checkReferenceSupports(const Scene& scene) {
-  if (!scene.surfaces.empty()) {
-    throw InputError(scene.path + ": surfaces: not supported by the CPU reference yet");
-  }
+  refuseSurfaces(scene);  // not rendered yet (issue 12)
 }
 
 Image renderReference(const Scene& scene, openvdb::FloatGrid::ConstPtr density,

@@ -10,7 +10,7 @@
 namespace plume {
 
 void checkGpuSupports(const Scene& scene, const std::string& renderer) {
-  if (!scene.surfaces.empty()) throw InputError(scene.path + ": surfaces: not supported by " + renderer + " yet");
+  refuseSurfaces(scene);  // no estimator renders them yet (issue 12)
 }
 
 std::vector<shared::GpuLight> gpuLights(const Scene& scene) {

@@ -105,7 +105,18 @@ RenderKey sceneRenderKey(const Scene& scene, int frame, const std::function<bool
   for (size_t i = 0; i < scene.lights.size(); ++i) key.add(strf("lights[%zu]", i), lightText(scene, scene.lights[i]));
   for (size_t i = 0; i < scene.surfaces.size(); ++i) {
     const Surface& s = scene.surfaces[i];
-    key.add(strf("surfaces[%zu]", i), sceneRelative(scene, s.obj) + ", albedo " + vec(s.albedo));
+    std::string text = s.plane ? "plane " + vec(s.plane->center) + " normal " + vec(s.plane->normal) + " size " +
+                                     num(s.plane->size.x) + " " + num(s.plane->size.y)
+                               : sceneRelative(scene, s.obj);
+    if (s.transform) {
+      text += ", transform";
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 4; ++c) text += " " + num((*s.transform)[c][r]);
+    }
+    text += s.material == SurfaceMaterial::Conductor ? ", conductor roughness " + num(s.roughness) + " f0 " + vec(s.f0)
+                                                     : ", albedo " + vec(s.albedo);
+    if (s.emits()) text += ", emission " + vec(s.emission);
+    key.add(strf("surfaces[%zu]", i), text);
   }
   // render.*: every setting of the table (frames, the range, is not one of them).
   for (const SettingDesc& d : renderSettingsTable()) {

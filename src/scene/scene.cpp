@@ -5,6 +5,7 @@
 
 #include <glm/geometric.hpp>
 #include <glm/glm.hpp>
+#include <glm/gtc/matrix_transform.hpp>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -238,6 +239,103 @@ Light parseLight(const json& j, const std::string& file, const std::string& dir,
   return l;
 }
 
+// `scale`: a number (uniform) or 3 numbers, none 0.
+glm::vec3 readScale(ObjectReader& r, const std::string& kp) {
+  const json* v = r.get("scale");
+  if (!v) return glm::vec3(1.0f);
+  glm::vec3 s(1.0f);
+  if (v->is_number()) s = glm::vec3(float(v->get<double>()));
+  else s = r.vec3Of(*v, kp, -kInf, kInf, "");
+  for (int a = 0; a < 3; ++a)
+    if (!std::isfinite(s[a]) || s[a] == 0.0f) r.fail(kp, "expected a non-zero number or 3 non-zero numbers");
+  return s;
+}
+
+glm::mat4 parseTransform(const json& j, const std::string& file, const std::string& kp) {
+  ObjectReader r(j, file, kp);
+  glm::mat4 m(1.0f);
+  if (const json* mat = r.get("matrix")) {
+    for (const char* k : {"translate", "rotate_deg", "scale"})
+      if (j.contains(k)) r.fail(kp + ".matrix", std::string("give either \"matrix\" or translate/rotate_deg/scale, not both (found \"") + k + "\")");
+    const std::string what = "expected 16 finite numbers (a 4x4 matrix, row-major, last row 0 0 0 1)";
+    if (!mat->is_array() || mat->size() != 16) r.fail(kp + ".matrix", what);
+    for (int row = 0; row < 4; ++row)
+      for (int col = 0; col < 4; ++col) {
+        const json& v = (*mat)[size_t(row * 4 + col)];
+        if (!v.is_number() || !std::isfinite(v.get<double>())) r.fail(kp + ".matrix", what);
+        m[col][row] = float(v.get<double>());
+      }
+    if (m[0][3] != 0.0f || m[1][3] != 0.0f || m[2][3] != 0.0f || m[3][3] != 1.0f)
+      r.fail(kp + ".matrix", "not affine: the last row must be 0 0 0 1");
+  } else {
+    const glm::vec3 t = r.vec3("translate", glm::vec3(0.0f), -kInf, kInf, "");
+    const glm::vec3 deg = r.vec3("rotate_deg", glm::vec3(0.0f), -kInf, kInf, "");
+    const glm::vec3 s = readScale(r, kp + ".scale");
+    // x' = T Rz Ry Rx S x, as geometry/mesh.h Transform::fromTrs (test_scene checks they agree).
+    const glm::mat4 id(1.0f);
+    m = glm::translate(id, t) * glm::rotate(id, glm::radians(deg.z), glm::vec3(0, 0, 1)) *
+        glm::rotate(id, glm::radians(deg.y), glm::vec3(0, 1, 0)) * glm::rotate(id, glm::radians(deg.x), glm::vec3(1, 0, 0)) *
+        glm::scale(id, s);
+  }
+  r.finish();
+  const double det = glm::determinant(glm::dmat3(m));
+  const glm::dmat3 l(m);
+  const double norm = std::max({glm::length(l[0]), glm::length(l[1]), glm::length(l[2])});
+  if (!(std::abs(det) > 1e-12 * norm * norm * norm)) r.fail(kp, "singular (the transform flattens the mesh)");
+  return m;
+}
+
+Surface parseSurface(const json& j, const std::string& file, const std::string& dir, size_t index) {
+  const std::string kp = strf("surfaces[%zu]", index);
+  ObjectReader r(j, file, kp);
+  Surface s;
+  const json* obj = r.get("obj");
+  const json* plane = r.get("plane");
+  if (!obj == !plane) r.fail(kp, "expected exactly one of \"obj\" (a mesh file) or \"plane\"");
+  if (obj) {
+    s.obj = resolvePath(dir, r.string("obj", ""));
+    if (!fs::exists(s.obj)) r.fail(kp + ".obj", "file not found: " + s.obj);
+  } else {
+    ObjectReader pr(*plane, file, kp + ".plane");
+    SurfacePlane p;
+    p.center = pr.vec3("center", p.center, -kInf, kInf, "");
+    const glm::vec3 n = pr.vec3("normal", p.normal, -kInf, kInf, "");
+    if (glm::length(n) < 1e-12f) pr.fail(kp + ".plane.normal", "zero-length direction");
+    p.normal = glm::normalize(n);
+    const json& size = pr.require("size");
+    const std::string what = "expected a positive number or 2 positive numbers";
+    if (size.is_number()) {
+      p.size = glm::vec2(float(size.get<double>()));
+    } else if (size.is_array() && size.size() == 2 && size[0].is_number() && size[1].is_number()) {
+      p.size = glm::vec2(float(size[0].get<double>()), float(size[1].get<double>()));
+    } else {
+      pr.fail(kp + ".plane.size", what);
+    }
+    if (!(p.size.x > 0.0f && p.size.y > 0.0f && std::isfinite(p.size.x) && std::isfinite(p.size.y))) pr.fail(kp + ".plane.size", what);
+    pr.finish();
+    s.plane = p;
+  }
+  if (const json* t = r.get("transform")) s.transform = parseTransform(*t, file, kp + ".transform");
+  const std::string material = r.string("material", "diffuse");
+  s.emission = r.vec3("emission", s.emission, 0.0, kInf, ">= 0");
+  if (material == "diffuse") {
+    if (j.contains("roughness") || j.contains("f0"))
+      r.fail(kp + (j.contains("roughness") ? ".roughness" : ".f0"), "belongs to \"material\": \"conductor\"");
+    s.albedo = r.vec3("albedo", s.emits() ? glm::vec3(0.0f) : s.albedo, 0.0, 1.0, "in [0,1]");
+  } else if (material == "conductor") {
+    s.material = SurfaceMaterial::Conductor;
+    if (j.contains("albedo")) r.fail(kp + ".albedo", "a conductor has no albedo: its colour is \"f0\"");
+    r.require("roughness");
+    r.require("f0");
+    s.roughness = float(r.number("roughness", 0.0, 0.0, 1.0, "in [0, 1] (GGX alpha)"));
+    s.f0 = r.vec3("f0", s.f0, 0.0, 1.0, "in [0,1]");
+  } else {
+    r.fail(kp + ".material", "expected \"diffuse\" or \"conductor\"");
+  }
+  r.finish();
+  return s;
+}
+
 }  // namespace
 
 bool hasFramePattern(const std::string& pattern) {
@@ -262,6 +360,10 @@ std::string expandFramePattern(const std::string& pattern, int frame) {
 
 bool Medium::animated() const { return hasFramePattern(vdb); }
 std::string Medium::vdbPath(int frame) const { return expandFramePattern(vdb, frame); }
+
+void refuseSurfaces(const Scene& scene) {
+  if (!scene.surfaces.empty()) throw InputError(scene.path + ": surfaces: surfaces are parsed but not yet rendered (issue 12)");
+}
 
 bool Scene::hasEnvironment() const {
   return std::any_of(lights.begin(), lights.end(), [](const Light& l) { return l.type == LightType::Environment; });
@@ -319,17 +421,7 @@ Scene parseScene(const json& doc, const std::string& path, const std::string& di
   }
   if (const json* surfaces = root.get("surfaces")) {
     if (!surfaces->is_array()) root.fail("surfaces", "expected an array of surfaces");
-    for (size_t i = 0; i < surfaces->size(); ++i) {
-      std::string kp = strf("surfaces[%zu]", i);
-      ObjectReader sr((*surfaces)[i], path, kp);
-      Surface s;
-      s.obj = resolvePath(dir, sr.string("obj", ""));
-      sr.require("obj");
-      if (!fs::exists(s.obj)) sr.fail(kp + ".obj", "file not found: " + s.obj);
-      s.albedo = sr.vec3("albedo", s.albedo, 0.0, 1.0, "in [0,1]");
-      sr.finish();
-      scene.surfaces.push_back(s);
-    }
+    for (size_t i = 0; i < surfaces->size(); ++i) scene.surfaces.push_back(parseSurface((*surfaces)[i], path, dir, i));
   }
   root.finish();
   return scene;

@@ -5,6 +5,8 @@
 
 #include "scene/settings.h"
 
+#include <glm/mat4x4.hpp>
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 #include <nlohmann/json_fwd.hpp>
 
@@ -84,9 +86,32 @@ struct Light {
   float scale = 1.0f;
 };
 
+// A surface (DESIGN §2 "Surfaces", §9 `surfaces[]`): a triangle mesh from an OBJ file or the
+// built-in plane, an optional affine transform, a material and an optional emission.
+enum class SurfaceMaterial { Diffuse, Conductor };
+
+// `plane`: a rectangle of size.x by size.y centred on `center`, facing `normal` (geometry/mesh.h
+// makePlane: for the ground, normal +Y, size.x runs along X and size.y along Z).
+struct SurfacePlane {
+  glm::vec3 center{0.0f};
+  glm::vec3 normal{0, 1, 0};
+  glm::vec2 size{1.0f};
+};
+
 struct Surface {
-  std::string obj;  // resolved path
-  glm::vec3 albedo{0.5f};
+  std::string obj;                     // resolved path; empty for a plane
+  std::optional<SurfacePlane> plane;
+  // `transform`: {"translate", "rotate_deg" (XYZ Euler: about X, then Y, then Z), "scale" (a number
+  // or 3)}, x' = T R S x, or {"matrix": 16 numbers, row-major, last row 0 0 0 1}. Column-major
+  // here (GLM); affine and invertible (checked on load).
+  std::optional<glm::mat4> transform;
+  SurfaceMaterial material = SurfaceMaterial::Diffuse;
+  glm::vec3 albedo{0.5f};              // diffuse (Lambert); 0 by default for an emitter
+  float roughness = 0.0f;              // conductor: GGX alpha in [0, 1] (Mitsuba's convention)
+  glm::vec3 f0{1.0f};                  // conductor: reflectance at normal incidence (Schlick)
+  glm::vec3 emission{0.0f};            // radiance leaving the front side (an area light)
+
+  bool emits() const { return emission != glm::vec3(0.0f); }
 };
 
 struct Scene {
@@ -103,6 +128,11 @@ struct Scene {
   const Medium& medium() const { return media.at(0); }
   Medium& medium() { return media.at(0); }
 };
+
+// Surfaces are parsed and validated but no estimator renders them yet (issue 12): every command
+// that renders calls this first. Throws InputError "<file>: surfaces: surfaces are parsed but not
+// yet rendered (issue 12)" when the scene has any.
+void refuseSurfaces(const Scene& scene);
 
 // Reads and validates a scene file. Throws InputError.
 Scene loadScene(const std::string& path);

@@ -17,6 +17,8 @@
 #include "shared/restir_types.h"
 #include "shared/bindings.h"
 #include "shared/kernel_counters.h"
+#include "shared/bvh.h"
+#include "shared/bsdf.h"
 
 // restir_mis.h reads its inputs through accessor macros (here: small tables).
 float misM[3];
@@ -53,6 +55,11 @@ layout(std430, binding = 4) readonly buffer BlackbodyBuffer {
 };
 #define BB_TABLE(i) bbTable[i].rgb
 #include "shared/blackbody.h"
+// bvh.h: the layout only (surface/bvh.glsl traverses it; shaders/tests/bvh_kernels.comp runs it).
+layout(std430, binding = 5) readonly buffer BvhBuffer {
+  BvhNode bvhNodes[2];
+  BvhTriangle bvhTriangles[];
+};
 
 void main() {
   uint i = gl_GlobalInvocationID.x;
@@ -125,6 +132,27 @@ void main() {
   // kernel_counters.h
   s += vec3(float(KC_WORDS + KC_WALKS + KC_SEGMENTS + KC_SEGMENT_ITERS + KC_STEPS + KC_STEP_ITERS + KC_LOOKUPS +
                   KC_LOOKUP_ITERS));
+  // bvh.h
+  BvhNode bn = bvhNodes[0];
+  BvhTriangle bt = bvhTriangles[bn.ref0 % 2u];
+  BvhHit bh;
+  bh.t = bn.lo1.x + bn.hi0.y;
+  bh.prim = bt.prim + bn.count0 + bn.count1 + bn.ref1 + BVH_NONE + BVH_MAX_LEAF_SIZE + uint(BVH_MAX_DEPTH + BVH_STACK_SIZE);
+  bh.u = bt.v1.x;
+  bh.v = bt.v2.y;
+  s += bn.hi1 + bt.v0 + vec3(bh.t, float(bh.prim), bh.u + bh.v);
+  // bsdf.h
+  Bsdf bsdf;
+  bsdf.color = vec3(0.5f);
+  bsdf.type = i % 2u == 0u ? BSDF_DIFFUSE : BSDF_CONDUCTOR;
+  bsdf.alpha = 0.3f;
+  bsdf.pad0 = bsdf.pad1 = bsdf.pad2 = 0.0f;
+  vec3 bwi;
+  float bpdf;
+  s += bsdf_sample(bsdf, wo, u, bwi, bpdf) * bpdf + bsdf_eval(bsdf, wo, bwi) * bsdf_pdf(bsdf, wo, bwi) +
+       bsdf_schlick(vec3(0.04f), u.x) * (bsdf_ggx_d(wo, 0.2f) + bsdf_ggx_g1(wo, 0.2f) + bsdf_ggx_g2(wo, bwi, 0.2f)) +
+       bsdf_ggx_eval(vec3(1.0f), 0.1f, wo, bwi) * (bsdf_ggx_pdf(0.1f, wo, bwi) + bsdf_lambert_pdf(wo, bwi) + bsdf_alpha(bsdf)) +
+       bsdf_lambert_sample(wo, u) + bsdf_ggx_sample_vndf(wo, 0.3f, u) * bsdf_ggx_lambda(wo, 0.3f) + vec3(BSDF_MIN_ALPHA);
   values[i] = vec4(s + wo, t + m + (picked ? 1.0f : 0.0f) + (dropped ? 2.0f : 0.0f) +
                    (rs_is_finite(back.W) ? back.W : 0.0f));
 }
