@@ -10,6 +10,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 #include "../restir/bindings.glsl"
 #include "../restir/bridge.glsl"
 #include "../restir/reuse.glsl"
+#include "../volume/loop_guard.glsl"
 
 #ifndef PLUME_RS_TEMPORAL
 #define PLUME_RS_TEMPORAL 0
@@ -22,4 +23,5 @@ void main() {
   if (pixel.x >= frame.size.x || pixel.y >= frame.size.y) return;
   rs_reuse_pixel(pixel, pixel.y * frame.size.x + pixel.x, PLUME_RS_TEMPORAL != 0, push.spatialRound, push.inSet,
                  push.historySet, push.outSet);
+  loop_guard_check();
 }

@@ -8,9 +8,11 @@ layout(local_size_x = 8, local_size_y = 8) in;
 #include "../restir/bindings.glsl"
 #include "../restir/bridge.glsl"
 #include "../restir/shade.glsl"
+#include "../volume/loop_guard.glsl"
 
 void main() {
   uvec2 pixel = gl_GlobalInvocationID.xy;
   if (pixel.x >= frame.size.x || pixel.y >= frame.size.y) return;
   rs_shade_pixel(pixel, push.inSet, push.restartAccumulation != 0u);
+  loop_guard_check();
 }

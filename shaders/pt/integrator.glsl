@@ -104,13 +104,17 @@ vec3 pt_trace_path(vec3 origin, vec3 dir, inout RngState rng) {
   return radiance;
 }
 
+#ifndef PT_SAMPLE_OFFSET
+#define PT_SAMPLE_OFFSET 0u
+#endif
+
 // All of a dispatch's samples of one pixel, merged into the accumulation.
 void pt_render_pixel(uvec2 pixel) {
   uint index = pixel.y * frame.size.x + pixel.x;
   vec4 batch = vec4(0.0f);  // (mean, n) of this dispatch's samples, and their M2
   vec3 m2 = vec3(0.0f);
   for (uint s = 0u; s < frame.spp; ++s) {
-    uint sampleIndex = frame.firstSample + s;
+    uint sampleIndex = frame.firstSample + PT_SAMPLE_OFFSET + s;
     RngState rng = rng_init(pixel, frame.frameKey, RNG_STREAM_PATH + (sampleIndex << 8u), frame.seed);
     vec2 u = rng_float2(rng);
     // Box filter, row 0 at the top (DESIGN §2).

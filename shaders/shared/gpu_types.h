@@ -105,7 +105,7 @@ struct GpuFrame {
   uint firstSample;      // index of this dispatch's first sample (path tracer)
   uint rrStartBounce;    // first bounce at which Russian roulette may end a path
   uint lightCount;
-  uint pad0;
+  uint loopProbe;        // 2: the trip count of the driver-loop-limit probe (volume/loop_guard.glsl)
   uint pad1;
   uint pad2;
 };

@@ -14,6 +14,7 @@ layout(binding = BIND_ATLAS) uniform sampler3D volAtlas;
 layout(std430, binding = BIND_INDIRECTION) readonly buffer IndirectionBuffer { uint volIndirection[]; };
 layout(std430, binding = BIND_MAJORANTS) readonly buffer MajorantBuffer { float volMajorants[]; };
 // volCounters[0]: tracking loops truncated by VOL_MAX_STEPS (no silent caps)
+// volCounters[1]: shader invocations whose loops the driver cut (volume/loop_guard.glsl)
 layout(std430, binding = BIND_VOLUME_COUNTERS) buffer CounterBuffer { uint volCounters[]; };
 
 #if defined(PLUME_VOL_MEAN_FIELD) || defined(PLUME_VOL_PREVIOUS)

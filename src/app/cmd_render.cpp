@@ -79,6 +79,13 @@ int renderFrames(const RenderArgs& a, const Scene& scene, gpu::Context& ctx, Est
     if (truncated > 0) {
       logWarn(strf("frame %d: %u tracking loops hit the step cap and were truncated", frame, truncated));
     }
+    const uint32_t loopCut = volume.loopLimitCount();
+    if (loopCut > 0) {
+      logWarn(strf("frame %d: the Vulkan driver cut the loops of %u shader invocations (llvmpipe ends every loop "
+                   "once an invocation has run 65535 iterations): this image is biased; render fewer samples "
+                   "per dispatch or on another device",
+                   frame, loopCut));
+    }
     if (!jobs[j].write) {
       progress.frameWarmed(frame, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
       continue;
@@ -91,6 +98,7 @@ int renderFrames(const RenderArgs& a, const Scene& scene, gpu::Context& ctx, Est
     image.meta["texels"] = texelFormatName(texels);
     image.meta["wall_time_s"] = strf("%.3f", seconds);
     image.meta["tracking_truncated"] = std::to_string(truncated);
+    image.meta["driver_loop_limit_hits"] = std::to_string(loopCut);
     estimator.describe(image.meta);
     a.outputs.write(frame, image);
     progress.frameDone(frame, a.outputs.exrPath(frame), seconds, estimator.detail());
@@ -128,7 +136,7 @@ void addRenderCommand(CLI::App& app, Action& action) {
   auto args = std::make_shared<RenderArgs>();
   CLI::App* cmd = app.add_subcommand("render", "render frames with the Vulkan renderer (mean + variance EXR)");
   addFrameJobOptions(*cmd, *args);
-  cmd->add_option("--batch", args->batch, "samples per pixel per dispatch")->check(CLI::Range(1, 4096));
+  cmd->add_option("--batch", args->batch, "path tracer: samples per pixel between progress updates (each dispatch renders one)")->check(CLI::Range(1, 4096));
   cmd->add_option("--preroll", args->preroll,
                   "warm temporal reuse on up to K frames before the first one (not written; for chunks that start "
                   "mid-sequence). No effect with --mode pt, whose frames are independent")

@@ -293,6 +293,13 @@ BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Sce
     }
   }
 
+  // No silent caps: truncated walks and loops cut by the driver (volume/loop_guard.glsl) bias a
+  // method's error, so the table is not to be read without this warning.
+  if (volume.truncatedCount() + volume.loopLimitCount() > 0) {
+    logWarn(strf("bench: %u tracking loops hit the step cap and the driver cut the loops of %u shader invocations: "
+                 "the affected rows are biased",
+                 volume.truncatedCount(), volume.loopLimitCount()));
+  }
   writeBenchReport(result, scene, o, first, dir);
   return result;
 }

@@ -84,6 +84,7 @@ shared::GpuFrame gpuFrame(const Scene& scene, int frame, uint32_t seed, uint32_t
   f.firstSample = 0u;
   f.rrStartBounce = uint32_t(rs.rrStartBounce);
   f.lightCount = uint32_t(scene.lights.size());
+  f.loopProbe = 2u;  // volume/loop_guard.glsl
   return f;
 }
 

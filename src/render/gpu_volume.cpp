@@ -138,6 +138,12 @@ uint32_t GpuVolumeResources::truncatedCount() const {
   return c[0];
 }
 
+uint32_t GpuVolumeResources::loopLimitCount() const {
+  uint32_t c[4];
+  counters_.download(c, sizeof c);
+  return c[1];
+}
+
 std::vector<uint32_t> GpuVolumeResources::counterWords() const {
   std::vector<uint32_t> words(shared::KC_WORDS);
   counters_.download(words.data(), words.size() * 4);

@@ -44,6 +44,9 @@ class GpuVolumeResources {
 
   // Tracking loops truncated by the step cap since the last reset (no silent caps).
   uint32_t truncatedCount() const;
+  // Shader invocations whose loops the Vulkan driver cut (llvmpipe's shared loop limit:
+  // volume/loop_guard.glsl); any is a biased image.
+  uint32_t loopLimitCount() const;
   // The whole counter buffer (shared::KC_WORDS words): after the volume's own, the kernel
   // benchmark's counters (shared/kernel_counters.h; zero unless a pass compiled them in).
   std::vector<uint32_t> counterWords() const;

@@ -6,6 +6,7 @@
 
 #include <glm/glm.hpp>
 
+#include <algorithm>
 #include <cmath>
 
 namespace plume {
@@ -39,7 +40,7 @@ gpu::ComputePass& PathTracer::makePass(bool skipEmpty) {
           ? gpu::bindingTable(shared::BIND_BLACKBODY + 1, {{shared::BIND_ATLAS, BindingType::SampledImage},
                                                             {shared::BIND_EMISSION_ATLAS, BindingType::SampledImage}})
           : gpu::bindingTable(shared::BIND_ENV_MAP + 1, {{shared::BIND_ATLAS, BindingType::SampledImage}}),
-      0,
+      sizeof(uint32_t),  // the push constant: this dispatch's sample (addSamples)
       "path tracing [" + features_.name() + (skipEmpty ? "+skip" : "") + "]", glm::uvec3(8, 8, 1));
   pass->set.bind(shared::BIND_FRAME, frameBuffer_);
   pass->set.bind(shared::BIND_LIGHTS, lightBuffer_);
@@ -65,16 +66,39 @@ void PathTracer::beginFrame(int frame) {
   samples_ = 0;
 }
 
+// One dispatch per sample per pixel: llvmpipe (lavapipe) gives every shader invocation a budget
+// of 65535 loop iterations, all loops and all samples of the dispatch together, and past it ends
+// every loop after one iteration without a word (volume/loop_guard.glsl); a dispatch of many
+// samples spent it in dense media and biased the image low. The dispatches of up to
+// kDispatchesPerSubmit samples share one submission (a push constant tells each its sample), and
+// their times are summed.
 void PathTracer::addSamples(int spp) {
-  frame_.spp = uint32_t(spp);
+  constexpr int kDispatchesPerSubmit = 16;  // GpuTimer holds 32 scopes
+  frame_.spp = 1u;
   frame_.firstSample = uint32_t(samples_);
   frameBuffer_.upload(&frame_, sizeof(frame_));
   const glm::uvec3 items(uint32_t(scene_.camera.width), uint32_t(scene_.camera.height), 1u);
-  ctx_.submitAndWait([&](VkCommandBuffer cmd) {
-    timer_.reset(cmd);
-    pass_->record(cmd, items, nullptr, &timer_);
-  });
-  passTimes_ = timer_.read();
+  passTimes_.clear();
+  for (int done = 0; done < spp;) {
+    const int n = std::min(spp - done, kDispatchesPerSubmit);
+    ctx_.submitAndWait([&](VkCommandBuffer cmd) {
+      timer_.reset(cmd);
+      for (int i = 0; i < n; ++i) {
+        if (i > 0) gpu::computeBarrier(cmd);
+        const uint32_t sampleOffset = uint32_t(done + i);
+        pass_->record(cmd, items, &sampleOffset, &timer_);
+      }
+    });
+    for (const auto& [name, ms] : timer_.read()) {
+      auto it = std::find_if(passTimes_.begin(), passTimes_.end(), [&](const auto& p) { return p.first == name; });
+      if (it == passTimes_.end()) {
+        passTimes_.emplace_back(name, ms);
+      } else {
+        it->second += ms;
+      }
+    }
+    done += n;
+  }
   samples_ += spp;
 }
 
