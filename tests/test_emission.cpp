@@ -261,6 +261,10 @@ Image restirMean(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& 
     meanSum += m;
     meanSum2 += m * m;
   }
+  // Truncated walks and loops the driver cut (volume/loop_guard.glsl) count as dropped paths.
+  const uint32_t cut = volume.truncatedCount() + volume.loopLimitCount();
+  if (cut > 0) std::printf("[emission] restir: %u truncated walks or driver-cut invocations\n", cut);
+  dropped += cut;
   Image out(scene.camera.width, scene.camera.height, true);
   const double r = runs;
   for (size_t i = 0; i < n; ++i) {

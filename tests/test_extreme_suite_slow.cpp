@@ -63,9 +63,11 @@ TEST_F(ExtremeSuiteSlow, Table) {
   std::ofstream(dir / "extreme.md") << table;
 }
 
-// Open (notes/extreme.md, finding 1): fails today, the path tracer's mean 3.7% below the
-// reference's (aggregate z -9..-10, 1 of 256 pixels fails the per-pixel test); the CI version
-// (test_extreme_suite.cpp, 8², 256/256 spp) resolves only ~7% and passes.
+// Open (notes/extreme.md, finding 1): the statistics pass since session 6 (mean ratio 0.997,
+// aggregate z -1.0, was 0.964 and z -9 before the path tracer dispatched one sample at a time),
+// but 16 of the 262144 sampled invocations still spend lavapipe's 65535-iteration loop budget on
+// one 256-bounce path and are cut (counted: volume/loop_guard.glsl), so the no-truncation
+// assertion fails. Needs shorter loops per invocation (a wavefront path tracer, issue 11).
 TEST_F(ExtremeSuiteSlow, DISABLED_DenseAndBright256BouncesMatchesReference) {
   const std::vector<test::ExtremeCase> cases = test::extremeCases({16, 256});
   for (const test::ExtremeCase& c : cases) {

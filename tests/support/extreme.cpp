@@ -211,7 +211,7 @@ EstimatorRun runRestirCase(gpu::Context& ctx, gpu::ShaderCompiler& compiler, con
     m /= double(n / 3);
     meanSum += m, meanSum2 += m * m;
   }
-  run.truncated = volume.truncatedCount() + restir.takeDroppedCount();
+  run.truncated = volume.truncatedCount() + volume.loopLimitCount() + restir.takeDroppedCount();
   run.image = Image(c.scene.camera.width, c.scene.camera.height, true);
   for (size_t i = 0; i < n; ++i) {
     const double mean = sum[i] / runs;

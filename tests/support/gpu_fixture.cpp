@@ -64,7 +64,7 @@ Image renderGpuPt(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene&
   for (int done = 0; done < scene.render.spp; done += 16) tracer.addSamples(std::min(16, scene.render.spp - done));
   if (info) {
     info->variant = tracer.variantName();
-    info->truncated = volume.truncatedCount();
+    info->truncated = volume.truncatedCount() + volume.loopLimitCount();  // both are truncations
   }
   return tracer.readImage();
 }
