@@ -21,5 +21,5 @@ void main() {
   uvec2 pixel = gl_GlobalInvocationID.xy;
   if (pixel.x >= frame.size.x || pixel.y >= frame.size.y) return;
   pt_render_pixel(pixel);
-  loop_guard_check();
+  loop_guard_check(frame.loopProbe);
 }

@@ -13,5 +13,5 @@ void main() {
   uvec2 pixel = gl_GlobalInvocationID.xy;
   if (pixel.x >= frame.size.x || pixel.y >= frame.size.y) return;
   rs_generate_candidates(pixel, pixel.y * frame.size.x + pixel.x, push.outSet);
-  loop_guard_check();
+  loop_guard_check(frame.loopProbe);
 }

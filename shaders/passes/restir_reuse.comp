@@ -23,5 +23,5 @@ void main() {
   if (pixel.x >= frame.size.x || pixel.y >= frame.size.y) return;
   rs_reuse_pixel(pixel, pixel.y * frame.size.x + pixel.x, PLUME_RS_TEMPORAL != 0, push.spatialRound, push.inSet,
                  push.historySet, push.outSet);
-  loop_guard_check();
+  loop_guard_check(frame.loopProbe);
 }

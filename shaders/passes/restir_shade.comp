@@ -14,5 +14,5 @@ void main() {
   uvec2 pixel = gl_GlobalInvocationID.xy;
   if (pixel.x >= frame.size.x || pixel.y >= frame.size.y) return;
   rs_shade_pixel(pixel, push.inSet, push.restartAccumulation != 0u);
-  loop_guard_check();
+  loop_guard_check(frame.loopProbe);
 }
