@@ -97,19 +97,7 @@ TEST_F(KernelCounters, RestirImageIsBitIdenticalAndCountsArePlausible) {
 // with emission here; ReSTIR's ratio tracking with emission in test_kernel_counters_slow.cpp).
 TEST_F(KernelCounters, EmittingMediumImagesAreBitIdentical) {
   Scene s = smallScene(12, 3);
-  s.media[0].albedo = glm::vec3(0.5f);
-  Emission e;
-  e.grid = "emission";
-  e.scale = 2.0f;
-  e.color = {1.0f, 0.5f, 0.25f};
-  s.media[0].emission = e;
-  LoadedGrid density, emission;
-  density.grid = test::makeNoiseGrid(24, 1.0 / 24);
-  density.name = "density";
-  emission.grid = test::makeNoiseGrid(24, 1.0 / 24, 5);
-  emission.name = "emission";
-  BakedVolume bake = bakeVolume(density);
-  bakeEmission(bake, density, emission);
+  const BakedVolume bake = test::makeEmittingCase(s);
   GpuVolumeResources volume(ctx(), bake, s.media[0].densityScale, &*s.media[0].emission);
   std::vector<uint32_t> plain, counted;
   const Image a = renderPt(s, volume, false, &plain);

@@ -21,19 +21,7 @@ class KernelCountersSlow : public test::GpuTest {};
 
 TEST_F(KernelCountersSlow, RestirEmittingMediumImageIsBitIdentical) {
   Scene s = test::smallScene(12, 3);
-  s.media[0].albedo = glm::vec3(0.5f);
-  Emission e;
-  e.grid = "emission";
-  e.scale = 2.0f;
-  e.color = {1.0f, 0.5f, 0.25f};
-  s.media[0].emission = e;
-  LoadedGrid density, emission;
-  density.grid = test::makeNoiseGrid(24, 1.0 / 24);
-  density.name = "density";
-  emission.grid = test::makeNoiseGrid(24, 1.0 / 24, 5);
-  emission.name = "emission";
-  BakedVolume bake = bakeVolume(density);
-  bakeEmission(bake, density, emission);
+  const BakedVolume bake = test::makeEmittingCase(s);
   GpuVolumeResources volume(ctx(), bake, s.media[0].densityScale, &*s.media[0].emission);
   std::vector<uint32_t> words[2];
   Image images[2];

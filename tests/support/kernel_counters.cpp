@@ -2,6 +2,7 @@
 
 #include "media/vdb_loader.h"
 #include "shaders/shared/kernel_counters.h"
+#include "support/grids.h"
 #include "support/scenes.h"
 
 #include <gtest/gtest.h>
@@ -11,6 +12,23 @@
 namespace plume::test {
 
 namespace sh = plume::shared;
+
+BakedVolume makeEmittingCase(Scene& s) {
+  s.media[0].albedo = glm::vec3(0.5f);
+  Emission e;
+  e.grid = "emission";
+  e.scale = 2.0f;
+  e.color = {1.0f, 0.5f, 0.25f};
+  s.media[0].emission = e;
+  LoadedGrid density, emission;
+  density.grid = makeNoiseGrid(24, 1.0 / 24);
+  density.name = "density";
+  emission.grid = makeNoiseGrid(24, 1.0 / 24, 5);
+  emission.name = "emission";
+  BakedVolume bake = bakeVolume(density);
+  bakeEmission(bake, density, emission);
+  return bake;
+}
 
 Scene smallScene(int size, int maxBounces) {
   Scene s;

@@ -16,6 +16,9 @@ namespace plume::test {
 // A camera on a unit box lit by a sun and a sky, 4 spp.
 Scene smallScene(int size, int maxBounces);
 BakedVolume bakeOf(openvdb::FloatGrid::Ptr grid);
+// Makes scene s an emitting medium (albedo 0.5, colour emission from a noise grid) and returns
+// the bake of its density and emission grids.
+BakedVolume makeEmittingCase(Scene& s);
 // The kernel counter words of a run (the counter buffer's words from KC_BASE on).
 std::vector<uint32_t> kernelWords(const GpuVolumeResources& volume);
 // The relations every tracker's block must satisfy:
