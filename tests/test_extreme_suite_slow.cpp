@@ -63,12 +63,11 @@ TEST_F(ExtremeSuiteSlow, Table) {
   std::ofstream(dir / "extreme.md") << table;
 }
 
-// Open (notes/extreme.md, finding 1): the statistics pass since session 6 (mean ratio 0.997,
-// aggregate z -1.0, was 0.964 and z -9 before the path tracer dispatched one sample at a time),
-// but 16 of the 262144 sampled invocations still spend lavapipe's 65535-iteration loop budget on
-// one 256-bounce path and are cut (counted: volume/loop_guard.glsl), so the no-truncation
-// assertion fails. Needs shorter loops per invocation (a wavefront path tracer, issue 11).
-TEST_F(ExtremeSuiteSlow, DISABLED_DenseAndBright256BouncesMatchesReference) {
+// notes/extreme.md, finding 1: 0.964 (z -9) while the path tracer ran many samples per dispatch
+// and lavapipe cut its loops; 0.997 with one sample per dispatch, but 16 of 262144 invocations
+// still spent the loop budget on one 256-bounce path; none since the wavefront path tracer
+// (session 7: mean ratio 0.9976, aggregate z -0.93, no truncation).
+TEST_F(ExtremeSuiteSlow, DenseAndBright256BouncesMatchesReference) {
   const std::vector<test::ExtremeCase> cases = test::extremeCases({16, 256});
   for (const test::ExtremeCase& c : cases) {
     if (c.name != "dense_bright") continue;

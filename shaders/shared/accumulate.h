@@ -1,7 +1,7 @@
 // Running per-pixel mean and variance of samples (DESIGN §2 Images: mean + variance of the
 // mean): (mean rgb, n) and M2 rgb, the sum of squared deviations from the mean. One merge (Chan
 // et al. 1979) adds a batch of nB samples with its own mean and M2; a single sample is the batch
-// (sample, M2 = 0, nB = 1), which is Welford's update. Shared by the path tracer (pt.comp) and
+// (sample, M2 = 0, nB = 1), which is Welford's update. Shared by the path tracer (pt_resolve.comp) and
 // ReSTIR's final shading (restir_shade.comp); C++ and GLSL (common.h).
 #ifndef PLUME_SHARED_ACCUMULATE_H
 #define PLUME_SHARED_ACCUMULATE_H

@@ -19,8 +19,11 @@ const uint BIND_VOLUME_COUNTERS = 4u;  // uint[]: [0] tracking loops truncated b
 const uint BIND_FRAME = 5u;            // GpuFrame
 const uint BIND_LIGHTS = 6u;           // GpuLight[]
 
-// The path tracer (shaders/passes/pt.comp).
+// The wavefront path tracer (shaders/pt/wavefront.glsl, shaders/passes/pt_*.comp).
 const uint BIND_PT_ACCUM = 7u;         // per pixel: vec4(mean rgb, n), vec4(M2 rgb, 0)
+const uint BIND_PT_PATHS = 8u;         // per path slot: 4 x vec4 (PtPath)
+const uint BIND_PT_QUEUES = 9u;        // uint[2 * slots]: the paths to extend, then those to shade
+const uint BIND_PT_WAVE = 10u;         // PtWave: queue lengths and the indirect dispatches
 
 // ReSTIR (shaders/restir/bindings.glsl): its parameters, the current volume's mean field, the
 // previous frame's volume (temporal reuse evaluates the history's target with it), reservoirs.

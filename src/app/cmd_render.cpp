@@ -82,8 +82,8 @@ int renderFrames(const RenderArgs& a, const Scene& scene, gpu::Context& ctx, Est
     const uint32_t loopCut = volume.loopLimitCount();
     if (loopCut > 0) {
       logWarn(strf("frame %d: the Vulkan driver cut the loops of %u shader invocations (llvmpipe ends every loop "
-                   "once an invocation has run 65535 iterations): this image is biased; render fewer samples "
-                   "per dispatch or on another device",
+                   "once an invocation has run 65535 iterations): this image is biased; render with fewer "
+                   "bounces or on another device",
                    frame, loopCut));
     }
     if (!jobs[j].write) {

@@ -186,6 +186,12 @@ Context::Context(const ContextOptions& options) {
     throw DeviceError(what + " (devices: " + (available.empty() ? "none" : available) + ")");
   }
   vkGetPhysicalDeviceProperties(physical_, &props_);
+  VkPhysicalDeviceSubgroupProperties subgroup{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
+  VkPhysicalDeviceProperties2 props2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+  props2.pNext = &subgroup;
+  vkGetPhysicalDeviceProperties2(physical_, &props2);
+  subgroupBallot_ = (subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) != 0 &&
+                    (subgroup.supportedOperations & VK_SUBGROUP_FEATURE_BALLOT_BIT) != 0;
   vkGetPhysicalDeviceMemoryProperties(physical_, &memProps_);
   queueFamily_ = uint32_t(computeQueueFamily(physical_, surface_));
   if (options.verbose) logInfo(strf("device: %s%s", props_.deviceName, validation_ ? " (validation on)" : ""));

@@ -52,6 +52,8 @@ class Context {
   const VkPhysicalDeviceLimits& limits() const { return props_.limits; }
   std::string deviceName() const { return props_.deviceName; }
   bool isCpuDevice() const { return props_.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU; }
+  // Whether compute shaders may use subgroup ballots (GL_KHR_shader_subgroup_ballot).
+  bool subgroupBallot() const { return subgroupBallot_; }
   bool validationEnabled() const { return validation_; }
   uint64_t validationMessages() const { return validationMessages_.load(); }
 
@@ -83,6 +85,7 @@ class Context {
   VkPhysicalDeviceProperties props_{};
   VkPhysicalDeviceMemoryProperties memProps_{};
   bool validation_ = false;
+  bool subgroupBallot_ = false;
   std::atomic<uint64_t> validationMessages_{0};
 };
 

@@ -171,10 +171,12 @@ std::vector<BindingType> bindingTable(uint32_t count, std::initializer_list<std:
 void computeBarrier(VkCommandBuffer cmd) {
   VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
   b.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
-  b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT;
+  b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT |
+                    VK_ACCESS_INDIRECT_COMMAND_READ_BIT;
   vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
-                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &b, 0,
-                       nullptr, 0, nullptr);
+                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT |
+                           VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT,
+                       0, 1, &b, 0, nullptr, 0, nullptr);
 }
 
 ComputePass::ComputePass(Context& ctx, const std::vector<uint32_t>& spirv, std::vector<BindingType> bindings,
@@ -182,8 +184,7 @@ ComputePass::ComputePass(Context& ctx, const std::vector<uint32_t>& spirv, std::
     : pipeline(ctx, spirv, std::move(bindings), pushConstantBytes, std::move(name)), set(ctx, pipeline),
       localSize(local) {}
 
-void ComputePass::record(VkCommandBuffer cmd, glm::uvec3 items, const void* push, GpuTimer* timer) const {
-  uint32_t scope = timer ? timer->begin(cmd, pipeline.name()) : 0;
+void ComputePass::bindAll(VkCommandBuffer cmd, const void* push) const {
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.pipeline());
   VkDescriptorSet s = set.handle();
   vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.layout(), 0, 1, &s, 0, nullptr);
@@ -191,8 +192,21 @@ void ComputePass::record(VkCommandBuffer cmd, glm::uvec3 items, const void* push
     PLUME_CHECK(push != nullptr);
     vkCmdPushConstants(cmd, pipeline.layout(), VK_SHADER_STAGE_COMPUTE_BIT, 0, pipeline.pushConstantBytes(), push);
   }
+}
+
+void ComputePass::record(VkCommandBuffer cmd, glm::uvec3 items, const void* push, GpuTimer* timer) const {
+  uint32_t scope = timer ? timer->begin(cmd, pipeline.name()) : 0;
+  bindAll(cmd, push);
   glm::uvec3 groups = (items + localSize - glm::uvec3(1)) / localSize;
   vkCmdDispatch(cmd, groups.x, groups.y, groups.z);
+  if (timer) timer->end(cmd, scope);
+}
+
+void ComputePass::recordIndirect(VkCommandBuffer cmd, const Buffer& args, VkDeviceSize offset, const void* push,
+                                 GpuTimer* timer) const {
+  uint32_t scope = timer ? timer->begin(cmd, pipeline.name()) : 0;
+  bindAll(cmd, push);
+  vkCmdDispatchIndirect(cmd, args.handle(), offset);
   if (timer) timer->end(cmd, scope);
 }
 

@@ -89,7 +89,7 @@ class GpuTimer {
   bool supported_ = false;
 };
 
-// Full compute->compute and compute->transfer memory barrier.
+// Full compute->compute, compute->transfer and compute->indirect-dispatch memory barrier.
 void computeBarrier(VkCommandBuffer cmd);
 
 struct ComputePass {
@@ -97,10 +97,17 @@ struct ComputePass {
               uint32_t pushConstantBytes, std::string name, glm::uvec3 localSize);
   // Dispatches enough groups to cover `items` threads; records timestamps if a timer is given.
   void record(VkCommandBuffer cmd, glm::uvec3 items, const void* push = nullptr, GpuTimer* timer = nullptr) const;
+  // Dispatches the groups written at `offset` of `args` (a VkDispatchIndirectCommand, by an
+  // earlier pass: `args` needs VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT).
+  void recordIndirect(VkCommandBuffer cmd, const Buffer& args, VkDeviceSize offset, const void* push = nullptr,
+                      GpuTimer* timer = nullptr) const;
 
   ComputePipeline pipeline;
   DescriptorSet set;
   glm::uvec3 localSize;
+
+ private:
+  void bindAll(VkCommandBuffer cmd, const void* push) const;  // pipeline, set and push constants
 };
 
 }  // namespace plume::gpu

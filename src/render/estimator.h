@@ -42,7 +42,7 @@ struct EstimatorTraits {
 const EstimatorTraits& estimatorTraits(EstimatorKind kind);
 
 struct EstimatorOptions {
-  int batch = 4;  // the path tracer: samples per pixel per dispatch in renderFrame
+  int batch = 4;  // the path tracer: samples per pixel between progress reports in renderFrame
   // Compiles the kernel benchmark's counters into the walk (FeatureSet::kernelCounters; read
   // with GpuVolumeResources::kernelCounters). Only `plume bench --kernels` sets it.
   bool kernelCounters = false;

@@ -3,16 +3,23 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "render/gpu_scene.h"
+#include "shaders/shared/pt_wave.h"
 
 #include <glm/glm.hpp>
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 
 namespace plume {
 
+namespace {
+constexpr uint32_t kBouncesPerSubmit = 16;  // extension + shading rounds recorded per submission
+}  // namespace
+
 PathTracer::PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene, bool kernelCounters)
-    : ctx_(ctx), scene_(scene), features_(featuresOf(scene)), compiler_(compiler), timer_(ctx) {
+    : ctx_(ctx), scene_(scene), features_(featuresOf(scene)), compiler_(compiler),
+      timer_(ctx, 2 * kBouncesPerSubmit) {
   features_.kernelCounters = kernelCounters;
   checkGpuSupports(scene, "the GPU path tracer");
   envMap_ = std::make_unique<GpuEnvironmentMap>(ctx, scene);
@@ -23,30 +30,54 @@ PathTracer::PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const S
   lightBuffer_ = gpu::Buffer(ctx, lights.size() * sizeof(shared::GpuLight), storage, "lights");
   lightBuffer_.upload(lights.data(), lights.size() * sizeof(shared::GpuLight));
   accum_ = gpu::Buffer(ctx, pixels * 2 * sizeof(glm::vec4), storage, "accumulation");
-  pass_ = &makePass(false);
+  slots_ = uint32_t(std::min<size_t>(pixels, kMaxSlots));
+  paths_ = gpu::Buffer(ctx, size_t(slots_) * 4 * sizeof(glm::vec4), storage, "path slots");
+  queues_ = gpu::Buffer(ctx, size_t(slots_) * 2 * sizeof(uint32_t), storage, "path queues");
+  wave_ = gpu::Buffer(ctx, sizeof(shared::PtWave), storage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, "path queue lengths");
+  const gpu::ShaderDefines none;
+  queue_ = makePass("passes/pt_queue.comp", none, "pt queues", false);
+  resolve_ = makePass("passes/pt_resolve.comp", none, "pt resolve", false);
+  active_ = &tracking(false);
 }
 
-gpu::ComputePass& PathTracer::makePass(bool skipEmpty) {
-  std::unique_ptr<gpu::ComputePass>& pass = passes_[skipEmpty ? 1 : 0];
-  if (pass) return *pass;
+std::unique_ptr<gpu::ComputePass> PathTracer::makePass(const std::string& file, const gpu::ShaderDefines& defines,
+                                                       const std::string& name, bool volumeTable) {
   using gpu::BindingType;
-  gpu::ShaderDefines defines = features_.defines();
+  gpu::ShaderDefines all = defines;
+  if (!ctx_.subgroupBallot()) all.emplace_back("PLUME_NO_SUBGROUP_BALLOT", "1");
   // Every sampled image in a table must be written before a dispatch (lavapipe reads them all):
-  // the emission atlas is in the table of an emitting scene only.
-  if (skipEmpty) defines.emplace_back("PLUME_SKIP_EMPTY", "1");
-  pass = std::make_unique<gpu::ComputePass>(
-      ctx_, compiler_.compile("passes/pt.comp", defines),
-      features_.emission
+  // the volume's images are in the tables of the kernels that walk it, the emission atlas only
+  // where the scene emits.
+  std::vector<BindingType> table =
+      !volumeTable ? gpu::bindingTable(shared::BIND_PT_WAVE + 1, {})
+      : features_.emission
           ? gpu::bindingTable(shared::BIND_BLACKBODY + 1, {{shared::BIND_ATLAS, BindingType::SampledImage},
                                                             {shared::BIND_EMISSION_ATLAS, BindingType::SampledImage}})
-          : gpu::bindingTable(shared::BIND_ENV_MAP + 1, {{shared::BIND_ATLAS, BindingType::SampledImage}}),
-      sizeof(uint32_t),  // the push constant: this dispatch's sample (addSamples)
-      "path tracing [" + features_.name() + (skipEmpty ? "+skip" : "") + "]", glm::uvec3(8, 8, 1));
+          : gpu::bindingTable(shared::BIND_ENV_MAP + 1, {{shared::BIND_ATLAS, BindingType::SampledImage}});
+  auto pass = std::make_unique<gpu::ComputePass>(ctx_, compiler_.compile(file, all), std::move(table),
+                                                 uint32_t(sizeof(shared::PtPush)), name,
+                                                 glm::uvec3(shared::PT_WAVE_GROUP, 1, 1));
   pass->set.bind(shared::BIND_FRAME, frameBuffer_);
-  pass->set.bind(shared::BIND_LIGHTS, lightBuffer_);
   pass->set.bind(shared::BIND_PT_ACCUM, accum_);
-  envMap_->bind(pass->set);
-  return *pass;
+  pass->set.bind(shared::BIND_PT_PATHS, paths_);
+  pass->set.bind(shared::BIND_PT_QUEUES, queues_);
+  pass->set.bind(shared::BIND_PT_WAVE, wave_);
+  if (volumeTable) {
+    pass->set.bind(shared::BIND_LIGHTS, lightBuffer_);
+    envMap_->bind(pass->set);
+  }
+  return pass;
+}
+
+PathTracer::Tracking& PathTracer::tracking(bool skipEmpty) {
+  Tracking& t = tracking_[skipEmpty ? 1 : 0];
+  if (t.extend) return t;
+  gpu::ShaderDefines defines = features_.defines();
+  if (skipEmpty) defines.emplace_back("PLUME_SKIP_EMPTY", "1");
+  const std::string variant = "[" + features_.name() + (skipEmpty ? "+skip" : "") + "]";
+  t.extend = makePass("passes/pt_extend.comp", defines, "pt extend " + variant, true);
+  t.shade = makePass("passes/pt_shade.comp", defines, "pt shade " + variant, true);
+  return t;
 }
 
 std::string PathTracer::variantName() const { return features_.name() + (skipEmpty_ ? "+skip" : ""); }
@@ -56,48 +87,101 @@ void PathTracer::setVolume(const GpuVolumeResources& volume) {
   const shared::GpuVolume& p = volume.params();
   const int widest = std::max(p.brickDims.x, std::max(p.brickDims.y, p.brickDims.z));
   skipEmpty_ = p.levelCount >= 2u && widest > 16;
-  pass_ = &makePass(skipEmpty_);
-  volume.bind(pass_->set);
+  active_ = &tracking(skipEmpty_);
+  volume.bind(active_->extend->set);
+  volume.bind(active_->shade->set);
 }
 
 void PathTracer::beginFrame(int frame) {
-  frame_ = gpuFrame(scene_, frame, uint32_t(scene_.render.seed), uint32_t(frame), 0u);
+  frame_ = gpuFrame(scene_, frame, uint32_t(scene_.render.seed), uint32_t(frame), 1u);
   accum_.fillZero();
   samples_ = 0;
 }
 
-// One dispatch per sample per pixel: llvmpipe (lavapipe) gives every shader invocation a budget
-// of 65535 loop iterations, all loops and all samples of the dispatch together, and past it ends
-// every loop after one iteration without a word (volume/loop_guard.glsl); a dispatch of many
-// samples spent it in dense media and biased the image low. The dispatches of up to
-// kDispatchesPerSubmit samples share one submission (a push constant tells each its sample), and
-// their times are summed.
-void PathTracer::addSamples(int spp) {
-  constexpr int kDispatchesPerSubmit = 16;  // GpuTimer holds 32 scopes
-  frame_.spp = 1u;
-  frame_.firstSample = uint32_t(samples_);
-  frameBuffer_.upload(&frame_, sizeof(frame_));
-  const glm::uvec3 items(uint32_t(scene_.camera.width), uint32_t(scene_.camera.height), 1u);
-  passTimes_.clear();
-  for (int done = 0; done < spp;) {
-    const int n = std::min(spp - done, kDispatchesPerSubmit);
+void PathTracer::addTimes() {
+  for (const auto& [name, ms] : timer_.read()) {
+    auto it = std::find_if(passTimes_.begin(), passTimes_.end(), [&](const auto& p) { return p.first == name; });
+    if (it == passTimes_.end()) {
+      passTimes_.emplace_back(name, ms);
+    } else {
+      it->second += ms;
+    }
+  }
+}
+
+// Every path of the generation is extended, its collision shaded, and so on, in rounds recorded
+// kBouncesPerSubmit at a time until the extension queue is empty (at most max_bounces + 1
+// extensions: a path ends at its (max_bounces + 1)-th collision). Then its samples are merged.
+void PathTracer::traceGeneration(uint32_t pixelBegin, uint32_t pixels, uint32_t sampleBase, uint32_t samples) {
+  shared::PtPush push{};
+  push.firstExtend = 1u;
+  push.pixelBegin = pixelBegin;
+  push.pixelCount = pixels;
+  push.sampleBase = sampleBase;
+  push.slots = pixels * samples;
+  PLUME_CHECK(push.slots <= slots_);
+  const shared::PtWave empty{};
+  wave_.upload(&empty, sizeof(empty));
+  constexpr VkDeviceSize kExtendArgs = offsetof(shared::PtWave, extendArgs);
+  constexpr VkDeviceSize kShadeArgs = offsetof(shared::PtWave, shadeArgs);
+  const uint64_t maxExtensions = uint64_t(frame_.maxBounces) + 1u;
+  for (uint64_t extensions = 0;;) {
     ctx_.submitAndWait([&](VkCommandBuffer cmd) {
       timer_.reset(cmd);
-      for (int i = 0; i < n; ++i) {
-        if (i > 0) gpu::computeBarrier(cmd);
-        const uint32_t sampleOffset = uint32_t(done + i);
-        pass_->record(cmd, items, &sampleOffset, &timer_);
+      for (uint32_t round = 0; round < kBouncesPerSubmit && extensions < maxExtensions; ++round, ++extensions) {
+        // Each kernel is timed with the queue kernel that follows it.
+        uint32_t scope = timer_.begin(cmd, active_->extend->pipeline.name());
+        if (push.firstExtend) {
+          active_->extend->record(cmd, glm::uvec3(push.slots, 1, 1), &push);
+        } else {
+          active_->extend->recordIndirect(cmd, wave_, kExtendArgs, &push);
+        }
+        push.firstExtend = 0u;
+        gpu::computeBarrier(cmd);
+        push.stage = shared::PT_QUEUE_TO_SHADE;
+        queue_->record(cmd, glm::uvec3(1), &push);
+        timer_.end(cmd, scope);
+        gpu::computeBarrier(cmd);
+        scope = timer_.begin(cmd, active_->shade->pipeline.name());
+        active_->shade->recordIndirect(cmd, wave_, kShadeArgs, &push);
+        gpu::computeBarrier(cmd);
+        push.stage = shared::PT_QUEUE_TO_EXTEND;
+        queue_->record(cmd, glm::uvec3(1), &push);
+        timer_.end(cmd, scope);
+        gpu::computeBarrier(cmd);
       }
     });
-    for (const auto& [name, ms] : timer_.read()) {
-      auto it = std::find_if(passTimes_.begin(), passTimes_.end(), [&](const auto& p) { return p.first == name; });
-      if (it == passTimes_.end()) {
-        passTimes_.emplace_back(name, ms);
-      } else {
-        it->second += ms;
-      }
+    addTimes();
+    shared::PtWave wave{};
+    wave_.download(&wave, sizeof(wave));
+    if (wave.extendArgs.w == 0u) break;
+    // A path still queued after max_bounces + 1 extensions would be a bug in the kernels.
+    PLUME_CHECK_MSG(extensions < maxExtensions, "path tracer: paths left after max_bounces + 1 extensions");
+  }
+  ctx_.submitAndWait([&](VkCommandBuffer cmd) {
+    timer_.reset(cmd);
+    resolve_->record(cmd, glm::uvec3(pixels, 1, 1), &push, &timer_);
+  });
+  addTimes();
+}
+
+// Generations of at most kMaxSlots paths: several samples of every pixel where the image is
+// small, a band of pixels at a time where it is large. Each path's random stream is its pixel's
+// and sample's (DESIGN §2), so the image does not depend on how the samples are grouped.
+void PathTracer::addSamples(int spp) {
+  frame_.firstSample = uint32_t(samples_);
+  frameBuffer_.upload(&frame_, sizeof(frame_));
+  const uint32_t pixels = uint32_t(scene_.camera.width) * uint32_t(scene_.camera.height);
+  passTimes_.clear();
+  for (uint32_t done = 0; done < uint32_t(spp);) {
+    if (pixels <= slots_) {
+      const uint32_t n = std::min(uint32_t(spp) - done, slots_ / pixels);
+      traceGeneration(0u, pixels, done, n);
+      done += n;
+    } else {
+      for (uint32_t begin = 0; begin < pixels; begin += slots_) traceGeneration(begin, std::min(slots_, pixels - begin), done, 1u);
+      done += 1;
     }
-    done += n;
   }
   samples_ += spp;
 }

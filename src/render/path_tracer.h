@@ -1,6 +1,9 @@
-// The GPU delta-tracking path tracer (DESIGN §4.1) on top of the baked volume: one compute pass
-// (shaders/passes/pt.comp) compiled for the scene's feature set, progressive accumulation of the
-// mean and M2 per pixel, read back as mean + variance of the mean.
+// The GPU delta-tracking path tracer (DESIGN §4.1) on top of the baked volume, organised as a
+// wavefront (shaders/pt/wavefront.glsl): generations of path slots (a sample of a pixel each) go
+// through an extension kernel (to the next real collision) and a shading kernel (next-event
+// estimation, roulette, phase sampling) over queues until every path has ended, then are merged
+// into the progressive accumulation of the mean and M2 per pixel, read back as mean + variance of
+// the mean. The kernels are compiled for the scene's feature set.
 #pragma once
 
 #include "gpu/pipeline.h"
@@ -29,8 +32,10 @@ class PathTracer {
   std::string variantName() const;
   // Clears the accumulation and sets the camera and seeds for `frame`.
   void beginFrame(int frame);
-  // Traces `spp` more samples per pixel (one dispatch, waits for it).
+  // Traces `spp` more samples per pixel (waits for them).
   void addSamples(int spp);
+  // Path slots per generation (samples of several pixels traced together).
+  static constexpr uint32_t kMaxSlots = 1u << 20;
   int samplesSoFar() const { return samples_; }
   Image readImage() const;  // mean + variance of the mean
   // The accumulation on the device (render/gpu_scene.h readAccumulation's layout), for a display
@@ -43,14 +48,26 @@ class PathTracer {
   const Scene& scene_;
   FeatureSet features_;
   std::unique_ptr<GpuEnvironmentMap> envMap_;
-  gpu::ComputePass& makePass(bool skipEmpty);
+  struct Tracking {  // the kernels that walk the volume, per variant
+    std::unique_ptr<gpu::ComputePass> extend, shade;
+  };
+  Tracking& tracking(bool skipEmpty);
+  std::unique_ptr<gpu::ComputePass> makePass(const std::string& file, const gpu::ShaderDefines& defines,
+                                             const std::string& name, bool volumeTable);
+  // Traces samples [sampleBase, sampleBase + samples) of pixels [pixelBegin, pixelBegin + pixels)
+  // to their ends and merges them into the accumulation.
+  void traceGeneration(uint32_t pixelBegin, uint32_t pixels, uint32_t sampleBase, uint32_t samples);
+  void addTimes();  // the timer's scopes into passTimes_, summed by pass
 
   gpu::ShaderCompiler& compiler_;
-  std::unique_ptr<gpu::ComputePass> passes_[2];  // [skip empty space]
-  gpu::ComputePass* pass_ = nullptr;
+  Tracking tracking_[2];  // [skip empty space]
+  Tracking* active_ = nullptr;
+  std::unique_ptr<gpu::ComputePass> queue_, resolve_;
   bool skipEmpty_ = false;
   gpu::GpuTimer timer_;
   gpu::Buffer frameBuffer_, lightBuffer_, accum_;
+  gpu::Buffer paths_, queues_, wave_;  // the wavefront's path slots, queues and PtWave
+  uint32_t slots_ = 0;                 // path slots allocated
   shared::GpuFrame frame_{};
   int samples_ = 0;
   PassTimes passTimes_;

@@ -20,7 +20,7 @@ class PathTracerEstimator final : public Estimator {
   std::string name() const override { return "path tracer [" + tracer_.features().name() + "]"; }
   void setVolumes(const GpuVolumeResources& current, const GpuVolumeResources*) override { tracer_.setVolume(current); }
 
-  // `spp` samples per pixel in dispatches of at most `batch`.
+  // `spp` samples per pixel, reported to samplesDone every `batch`.
   void renderFrame(int frame, int spp, const SamplesDone& samplesDone) override {
     tracer_.beginFrame(frame);
     for (int done = 0; done < spp;) {
@@ -40,7 +40,7 @@ class PathTracerEstimator final : public Estimator {
 
   RenderKey renderKey(int frame) const override {
     RenderKey key = sceneRenderKey(scene_, frame, usesSetting);
-    key.add("batch", std::to_string(batch_));  // the running mean is merged per dispatch: the last bits differ
+    key.add("batch", std::to_string(batch_));  // frames from before session 7 depend on it (docs/farm.md)
     return key;
   }
   void describe(std::map<std::string, std::string>& meta) const override {

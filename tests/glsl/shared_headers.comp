@@ -19,6 +19,7 @@
 #include "shared/kernel_counters.h"
 #include "shared/bvh.h"
 #include "shared/bsdf.h"
+#include "shared/pt_wave.h"
 
 // restir_mis.h reads its inputs through accessor macros (here: small tables).
 float misM[3];
@@ -153,6 +154,12 @@ void main() {
        bsdf_schlick(vec3(0.04f), u.x) * (bsdf_ggx_d(wo, 0.2f) + bsdf_ggx_g1(wo, 0.2f) + bsdf_ggx_g2(wo, bwi, 0.2f)) +
        bsdf_ggx_eval(vec3(1.0f), 0.1f, wo, bwi) * (bsdf_ggx_pdf(0.1f, wo, bwi) + bsdf_lambert_pdf(wo, bwi) + bsdf_alpha(bsdf)) +
        bsdf_lambert_sample(wo, u) + bsdf_ggx_sample_vndf(wo, 0.3f, u) * bsdf_ggx_lambda(wo, 0.3f) + vec3(BSDF_MIN_ALPHA);
+  // pt_wave.h (layouts only)
+  PtWave wave;
+  wave.extendArgs = uvec4(PT_WAVE_GROUP, PT_QUEUE_TO_SHADE, PT_QUEUE_TO_EXTEND, i);
+  PtPush push;
+  push.slots = wave.extendArgs.w;
+  t += float(push.slots + wave.extendArgs.x);
   values[i] = vec4(s + wo, t + m + (picked ? 1.0f : 0.0f) + (dropped ? 2.0f : 0.0f) +
                    (rs_is_finite(back.W) ? back.W : 0.0f));
 }

@@ -1,0 +1,23 @@
+// The path tracer's extension kernel (pt/wavefront.glsl): every queued path — or, for the
+// generation's first dispatch, every slot's camera ray — to its next real collision; the collided
+// ones are queued for shading.
+#version 450
+#extension GL_GOOGLE_include_directive : require
+
+layout(local_size_x = 64) in;
+
+#include "../volume/bindings.glsl"
+#include "../scene/bindings.glsl"
+#include "../pt/wavefront.glsl"
+#include "../pt/integrator.glsl"
+#include "../volume/loop_guard.glsl"
+
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  bool camera = ptPush.firstExtend != 0u;
+  bool live = i < (camera ? ptPush.slots : wave.extendArgs.w);
+  uint slot = live ? (camera ? i : ptQueues[i]) : 0u;
+  bool collided = live && pt_extend(slot, camera);
+  pt_enqueue(PT_TO_SHADE, slot, collided);
+  loop_guard_check(frame.loopProbe);
+}

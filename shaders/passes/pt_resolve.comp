@@ -1,0 +1,27 @@
+// The path tracer's resolve kernel (pt/wavefront.glsl): a finished generation's samples merged
+// into the pixels' running mean and M2, one invocation per pixel, in sample order (a loop of at
+// most PathTracer's samples per generation, far below the driver's loop budget).
+#version 450
+#extension GL_GOOGLE_include_directive : require
+
+layout(local_size_x = 64) in;
+
+#include "../scene/bindings.glsl"
+#include "../pt/wavefront.glsl"
+#include "../shared/accumulate.h"
+
+// Per pixel: ptAccum[2i] = (mean rgb, n), ptAccum[2i+1] = (M2 rgb, 0).
+layout(std430, binding = BIND_PT_ACCUM) buffer AccumBuffer { vec4 ptAccum[]; };
+
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= ptPush.pixelCount) return;
+  uint index = ptPush.pixelBegin + i;
+  vec4 a = ptAccum[2u * index];
+  vec3 m2a = ptAccum[2u * index + 1u].rgb;
+  for (uint slot = i; slot < ptPush.slots; slot += ptPush.pixelCount) {
+    acc_merge(a, m2a, ptPaths[slot].radiance, vec3(0.0f), 1.0f);
+  }
+  ptAccum[2u * index] = a;
+  ptAccum[2u * index + 1u] = vec4(m2a, 0.0f);
+}

@@ -1,0 +1,21 @@
+// The path tracer's shading kernel (pt/wavefront.glsl): next-event estimation at every collided
+// path's new vertex, roulette and phase sampling; the survivors are queued for extension.
+#version 450
+#extension GL_GOOGLE_include_directive : require
+
+layout(local_size_x = 64) in;
+
+#include "../volume/bindings.glsl"
+#include "../scene/bindings.glsl"
+#include "../pt/wavefront.glsl"
+#include "../pt/integrator.glsl"
+#include "../volume/loop_guard.glsl"
+
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  bool live = i < wave.shadeArgs.w;
+  uint slot = live ? ptQueues[ptPush.slots + i] : 0u;
+  bool more = live && pt_shade(slot);
+  pt_enqueue(PT_TO_EXTEND, slot, more);
+  loop_guard_check(frame.loopProbe);
+}

@@ -1,0 +1,80 @@
+// The wavefront path tracer's state (DESIGN §4.1; render/path_tracer.cpp drives it): a generation
+// of path slots (shared/pt_wave.h), each slot's path between its kernels, and the two queues.
+// pt_extend.comp takes every queued path to its next real collision or out of the volume;
+// pt_shade.comp estimates next-event transmittance at the collided ones, then rolls the roulette
+// and samples the phase function; pt_queue.comp turns one kernel's output queue into the other's
+// indirect dispatch; pt_resolve.comp merges a generation's samples into the accumulation. Every
+// kernel's hot loop holds only its own code, runs on densely packed lanes, and no invocation
+// walks more than one path segment and its shadow rays (llvmpipe's loop budget,
+// volume/loop_guard.glsl).
+// Requires scene/bindings.glsl.
+#ifndef PLUME_PT_WAVEFRONT_GLSL
+#define PLUME_PT_WAVEFRONT_GLSL
+
+#ifndef PLUME_NO_SUBGROUP_BALLOT
+#extension GL_KHR_shader_subgroup_basic : require
+#extension GL_KHR_shader_subgroup_ballot : require
+#endif
+
+#include "../shared/pt_wave.h"
+#include "../shared/rng.h"
+
+// A path between kernels: after pt_extend, origin is its newest vertex; after pt_shade, dir is
+// the direction leaving it. counter: the draw counter of the slot's random stream (the key is a
+// hash of pixel and sample, recomputed by every kernel).
+struct PtPath {
+  vec3 origin;
+  float phasePdf;  // the pdf with which the last vertex drew dir (an environment map's MIS)
+  vec3 dir;
+  uint scatterings;
+  vec3 beta;
+  uint counter;
+  vec3 radiance;
+  uint pad;
+};
+
+layout(std430, binding = BIND_PT_PATHS) buffer PathBuffer { PtPath ptPaths[]; };
+// [0, slots): the paths to extend; [slots, 2 slots): the paths to shade.
+layout(std430, binding = BIND_PT_QUEUES) buffer QueueBuffer { uint ptQueues[]; };
+layout(std430, binding = BIND_PT_WAVE) buffer WaveBuffer { PtWave wave; };
+layout(push_constant) uniform PtPushBlock { PtPush ptPush; };
+
+// The pixel of a slot, and the index of its sample in the frame.
+uint pt_slot_sample(uint slot, out uvec2 pixel) {
+  uint p = ptPush.pixelBegin + slot % ptPush.pixelCount;
+  pixel = uvec2(p % frame.size.x, p / frame.size.x);
+  return frame.firstSample + ptPush.sampleBase + slot / ptPush.pixelCount;
+}
+
+// The slot's random stream at draw `counter` (the stream of sample s of a pixel: DESIGN §2).
+RngState pt_slot_rng(uint slot, uint counter) {
+  uvec2 pixel;
+  uint sampleIndex = pt_slot_sample(slot, pixel);
+  RngState rng = rng_init(pixel, frame.frameKey, RNG_STREAM_PATH + (sampleIndex << 8u), frame.seed);
+  rng.counter = counter;
+  return rng;
+}
+
+const uint PT_TO_EXTEND = 0u;
+const uint PT_TO_SHADE = 1u;
+
+// Appends `slot` to a queue where `push` (every lane of the subgroup calls this together): one
+// atomic per subgroup, each lane's place from the ballot (per-lane atomics loop over the lanes on
+// a SIMD back end).
+void pt_enqueue(const uint queue, uint slot, bool push) {
+#ifdef PLUME_NO_SUBGROUP_BALLOT
+  if (!push) return;
+  uint at = queue == PT_TO_SHADE ? atomicAdd(wave.shadeCount, 1u) : atomicAdd(wave.extendCount, 1u);
+#else
+  uvec4 ballot = subgroupBallot(push);
+  uint n = subgroupBallotBitCount(ballot);
+  uint base = 0u;
+  if (subgroupElect() && n > 0u) base = queue == PT_TO_SHADE ? atomicAdd(wave.shadeCount, n) : atomicAdd(wave.extendCount, n);
+  base = subgroupBroadcastFirst(base);
+  if (!push) return;
+  uint at = base + subgroupBallotExclusiveBitCount(ballot);
+#endif
+  ptQueues[(queue == PT_TO_SHADE ? ptPush.slots : 0u) + at] = slot;
+}
+
+#endif
