@@ -18,6 +18,7 @@
 #include "support/gpu_fixture.h"
 #include "support/reference_check.h"
 #include "support/resolution.h"
+#include "support/run_accumulator.h"
 #include "support/scenes.h"
 #include "support/test_support.h"
 
@@ -61,36 +62,6 @@ Scene fireScene() {
   s.render.seed = 4242;
   return s;
 }
-
-struct Acc {
-  std::vector<double> sum, sum2;
-  glm::dvec3 ms{0.0}, ms2{0.0};
-  int n = 0;
-  void add(const Image& im) {
-    if (sum.empty()) sum.assign(im.rgb.size(), 0.0), sum2.assign(im.rgb.size(), 0.0);
-    glm::dvec3 m(0.0);
-    for (size_t i = 0; i < im.rgb.size(); ++i) {
-      sum[i] += im.rgb[i], sum2[i] += double(im.rgb[i]) * im.rgb[i];
-      m[int(i % 3)] += im.rgb[i];
-    }
-    m /= double(im.rgb.size() / 3);
-    ms += m, ms2 += m * m;
-    ++n;
-  }
-  Image image(int w, int h) const {
-    Image out(w, h, true);
-    for (size_t i = 0; i < sum.size(); ++i) {
-      const double mean = sum[i] / n;
-      out.rgb[i] = float(mean);
-      out.var[i] = float(std::max(0.0, (sum2[i] / n - mean * mean)) * n / (n - 1.0) / n);
-    }
-    return out;
-  }
-  glm::dvec3 mv() const {
-    const glm::dvec3 mean = ms / double(n);
-    return glm::max(ms2 / double(n) - mean * mean, glm::dvec3(0.0)) * (n / (n - 1.0)) / double(n);
-  }
-};
 
 // ReSTIR's mean over independent runs against the reference, and the pixels of largest |z|.
 TEST_F(GpuRestirFireDiag, DISABLED_AgainstReference) {
@@ -137,7 +108,7 @@ TEST_F(GpuRestirFireDiag, DISABLED_AgainstReference) {
   std::unique_ptr<GpuVolumeResources> other;
   if (env("DIAG_PREV_COPY", 0)) other = std::make_unique<GpuVolumeResources>(ctx(), bake, s.medium().densityScale);
   Restir restir(ctx(), compiler(), s, o);
-  Acc acc;
+  test::RunAccumulator acc;
   uint32_t dropped = 0;
   for (int run = 0; run < runs; ++run) {
     restir.resetHistory();
@@ -152,7 +123,7 @@ TEST_F(GpuRestirFireDiag, DISABLED_AgainstReference) {
   const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   Image mean = acc.image(s.camera.width, s.camera.height);
   test::ReferenceCheckOptions opt;
-  opt.imageMeanVariance = acc.mv();
+  opt.imageMeanVariance = acc.imageMeanVariance();
   opt.outputGroup = "diag";
   if (env("DIAG_MASK", 1)) {
     const auto map = test::referenceResolution(s, *grid, refSpp);
