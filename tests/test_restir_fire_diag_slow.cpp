@@ -7,7 +7,9 @@
 //   DIAG_TOP (pixels listed), DIAG_OUT (EXR of the mean), DIAG_CMP (EXR whose values to list too),
 //   DIAG_SIZE, DIAG_FOV, DIAG_SCALE, DIAG_BOUNCES, DIAG_FRAME (20), DIAG_PREV_COPY (1: the previous
 //   frame's volume is a second upload of the same bake, so the history is not the same domain and
-//   the temporal pass evaluates its cross-domain targets on the previous volume).
+//   the temporal pass evaluates its cross-domain targets on the previous volume), DIAG_ANIMATED (1:
+//   the frames of a run render caches frameNo - 2 (frames - f), each with its predecessor's volume
+//   as the history's).
 // The reference is cached in /tmp/plume_fire_diag_ref_*.exr (by frame, size, fov, scale, bounces, spp, seed).
 #include "io/image.h"
 #include "media/bake.h"
@@ -107,6 +109,14 @@ TEST_F(GpuRestirFireDiag, DISABLED_AgainstReference) {
   GpuVolumeResources volume(ctx(), bake, s.medium().densityScale);
   std::unique_ptr<GpuVolumeResources> other;
   if (env("DIAG_PREV_COPY", 0)) other = std::make_unique<GpuVolumeResources>(ctx(), bake, s.medium().densityScale);
+  // DIAG_ANIMATED: frame f of a run renders the cache frameNo - 2 (frames - f) (the caches hold
+  // every other frame), the previous one's volume bound as the history's; the last is frameNo.
+  std::vector<std::unique_ptr<GpuVolumeResources>> animated;
+  for (int f = 1; env("DIAG_ANIMATED", 0) && f <= frames; ++f) {
+    std::snprintf(name, sizeof name, "/fire/fire_%04d.vdb", frameNo - 2 * (frames - f));
+    LoadedGrid g = loadFloatGrid(shared + name, "density");
+    animated.push_back(std::make_unique<GpuVolumeResources>(ctx(), bakeVolume(g), s.medium().densityScale));
+  }
   Restir restir(ctx(), compiler(), s, o);
   test::RunAccumulator acc;
   uint32_t dropped = 0;
@@ -114,7 +124,11 @@ TEST_F(GpuRestirFireDiag, DISABLED_AgainstReference) {
     restir.resetHistory();
     Image img;
     for (int f = 1; f <= frames; ++f) {
-      restir.setVolumes(volume, other ? *other : volume);
+      if (!animated.empty()) {
+        restir.setVolumes(*animated[size_t(f - 1)], *animated[size_t(std::max(f - 2, 0))]);
+      } else {
+        restir.setVolumes(volume, other ? *other : volume);
+      }
       img = restir.renderFrame(f, uint32_t(run + 1 + env("DIAG_SEQ", 0)));
     }
     dropped += restir.takeDroppedCount();
