@@ -14,6 +14,7 @@
 #include "support/gpu_fixture.h"
 #include "support/grids.h"
 #include "support/reference_check.h"
+#include "support/resolution.h"
 #include "support/scenes.h"
 #include "support/test_support.h"
 
@@ -278,13 +279,15 @@ Image restirMean(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& 
   return out;
 }
 
+// `unresolved`: pixels left out of the per-pixel test (support/resolution.h; empty: none).
 void compareRestir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene, const RestirOptions& options,
                    int frames, int refSpp, const std::string& label, openvdb::FloatGrid::Ptr density = nullptr,
-                   openvdb::FloatGrid::Ptr emission = nullptr) {
+                   openvdb::FloatGrid::Ptr emission = nullptr, std::vector<bool> unresolved = {}) {
   if (!density) density = test::makeNoiseGrid(40, 1.0 / 20, 3);
   if (!emission) emission = test::makeNoiseGrid(40, 1.0 / 20, 8);
   test::ReferenceCheckOptions opt;
   opt.outputGroup = "emission";
+  opt.unresolved = std::move(unresolved);
   glm::dvec3 meanVariance;
   uint32_t dropped = 0;
   Image img = restirMean(ctx, compiler, scene, options, density, emission, 256, frames, meanVariance, dropped);
@@ -349,9 +352,10 @@ TEST_F(GpuEmission, RestirShortPrefixWithEmissionTailMatchesReference) {
 }
 
 // The Blender fire (Mantaflow's temperature as blackbody) with ReSTIR. `temporal`: three frames
-// with temporal and spatial reuse; without: one frame, spatial reuse only.
+// with temporal and spatial reuse; without: one frame, spatial reuse only. `resolvedOnly`: the
+// per-pixel test skips the pixels the 8192-sample reference cannot resolve (support/resolution.h).
 void compareRestirBlenderFire(gpu::Context& ctx, gpu::ShaderCompiler& compiler, bool temporal, float emissionScale,
-                              const std::string& label) {
+                              bool resolvedOnly, const std::string& label) {
   const std::string shared = test::sharedVolumesPath();
   if (shared.empty()) GTEST_SKIP() << test::sharedVolumesMissing();
   const std::string file = shared + "/fire/fire_0020.vdb";
@@ -366,23 +370,34 @@ void compareRestirBlenderFire(gpu::Context& ctx, gpu::ShaderCompiler& compiler, 
   RestirOptions o;
   o.radius = 2;
   if (!temporal) o.historyCap = 0;
-  compareRestir(ctx, compiler, s, o, temporal ? 3 : 1, 8192, label, loadFloatGrid(file, "density").grid,
-                loadFloatGrid(file, "temperature").grid);
+  const int refSpp = 8192;
+  openvdb::FloatGrid::Ptr density = loadFloatGrid(file, "density").grid;
+  std::vector<bool> unresolved;
+  if (resolvedOnly) {
+    const test::ResolutionMap map = test::referenceResolution(s, *density, refSpp);
+    unresolved = map.unresolvedMask();
+    std::printf("[emission] %s: %d of %d pixels unresolved by the reference\n", label.c_str(),
+                map.count(test::PixelResolution::Unresolved), map.width * map.height);
+  }
+  compareRestir(ctx, compiler, s, o, temporal ? 3 : 1, refSpp, label, density, loadFloatGrid(file, "temperature").grid,
+                std::move(unresolved));
 }
 
 TEST_F(GpuEmission, RestirBlenderFireSpatialMatchesReference) {
-  compareRestirBlenderFire(ctx(), compiler(), false, 6.0f, "restir_blender_fire_spatial");
+  compareRestirBlenderFire(ctx(), compiler(), false, 6.0f, false, "restir_blender_fire_spatial");
 }
 
-// OPEN (notes/restir.md, session 5): with temporal reuse over three frames of the still Blender
-// fire, ReSTIR is biased high on this grid *without any emission* (emission scale 0, the dim sun
-// alone: aggregate mean ratio 1.016, z 2.65; pixel (5, 8) z 5.3, the same pixel for two reference
-// seeds and 2048 or 8192 reference samples), while no reuse and spatial reuse alone pass. Emission
-// is not the cause: a scene with no emission at all (test_restir.cpp's harness, same camera,
-// grid and sun) fails the same way (mean ratio 1.0106, a pixel at z 5.16). The temporal path on
-// Mantaflow's thin wisps (values down to 1e-6) is the suspect. Enable when found.
-TEST_F(GpuEmission, DISABLED_RestirBlenderFireTemporalMatchesReference) {
-  compareRestirBlenderFire(ctx(), compiler(), true, 0.0f, "restir_blender_fire_temporal_no_emission");
+// Temporal and spatial reuse over three frames of the still Blender fire, without emission (the
+// dim sun alone). Its per-pixel test leaves out the pixels the reference cannot resolve:
+// Mantaflow's wisps (density down to 1e-6) give pixels whose camera rays collide with
+// probability 1e-10 to 1e-4, where the 8192-sample reference is exactly 0 with a variance of 0
+// while reuse brings tiny values into them (1e-11 to 1e-7; the image's mean is 7.6e-4). Testing
+// every pixel, this failed at z 5.3 on such a pixel (session 5), and spatial reuse alone fails
+// the same way given 8192 runs; there is no bias: over 2048 runs this test's aggregate ratio is
+// 1.0014 (z 0.45), and 8192 runs of the same scene without emission give 1.00003 against 131072
+// reference samples (notes/restir.md, "Thin wisps").
+TEST_F(GpuEmission, RestirBlenderFireTemporalMatchesReference) {
+  compareRestirBlenderFire(ctx(), compiler(), true, 0.0f, true, "restir_blender_fire_temporal_no_emission");
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <vector>
 
 namespace plume::test {
 
@@ -29,6 +30,10 @@ struct ReferenceCheckOptions {
   // pixels (ReSTIR's spatial reuse) correlate them, and that sum then underestimates it: pass the
   // variance measured across independent runs instead.
   std::optional<glm::dvec3> imageMeanVariance;
+  // Pixels left out of the per-pixel test (row-major; empty: none), those where the reference
+  // rests on too few non-zero samples for a variance (support/resolution.h). The aggregate test
+  // keeps every pixel.
+  std::vector<bool> unresolved;
   std::string outputGroup = "reference_check";  // failures go to build/test-output/<group>/<test>/
 };
 
@@ -49,8 +54,9 @@ struct AggregateZResult {
 };
 
 struct ReferenceCheck {
-  ZTestResult pixels;
+  ZTestResult pixels;  // over the resolved pixels (its z image has every pixel's)
   AggregateZResult aggregate;
+  size_t unresolvedPixels = 0;  // left out of the per-pixel test
   bool pass() const { return pixels.pass && aggregate.pass; }
   std::string summary() const;  // relMSE, mean ratios, both tests' verdicts
 };
