@@ -5,7 +5,9 @@
 // and M2 per pixel (Chan et al.'s parallel variance update), so the accumulation gives the
 // variance of the mean. Variant defines: PLUME_HAS_SUN, PLUME_HAS_POINT, PLUME_HAS_ENV, PLUME_HAS_ENV_MAP,
 // PLUME_MULTI_BOUNCE, PLUME_HAS_EMISSION (the medium's emission gathered along every segment by
-// delta tracking).
+// delta tracking), PLUME_HAS_SURFACES (a ray ends at the nearer of the medium's collision and the
+// first surface; both are vertices, DESIGN §4.3), PLUME_HAS_EMITTERS (emissive triangles: NEE by
+// area sampling and BSDF/phase-sampled hits, combined by the power heuristic).
 // An environment map is reached two ways, combined by the power heuristic (Veach's thesis, eq.
 // 9.15): next-event estimation draws a direction from the map (pdf p_l) and the path's next
 // phase-sampled direction (pdf p_ph), which adds the map's radiance where it escapes; weights
@@ -18,10 +20,27 @@
 #include "../volume/grid.glsl"
 #include "../volume/walk.glsl"
 #include "../light/light.glsl"
+#ifdef PLUME_HAS_SURFACES
+#include "../surface/surfaces.glsl"
+#endif
 #include "../integrator/vertex.glsl"
 
-// Next-event estimation at a vertex x of a path arriving along rayDir: one sample per light.
-vec3 pt_direct(uint kind, vec3 x, vec3 rayDir, inout RngState rng) {
+// Transmittance times visibility from the vertex along w over (0, dist): ratio tracking, and
+// any surface in between blocks the light.
+float pt_shadow(PathVertex v, vec3 w, float dist, inout RngState rng) {
+  vec3 o = vtx_at_origin(v, w);
+#ifdef PLUME_HAS_SURFACES
+  if (surf_occluded(o, w, dist)) return 0.0f;
+#endif
+  return vol_ratio_tracking(o, w, dist, rng);
+}
+
+float pt_power_heuristic(float a, float b) { return a * a / (a * a + b * b); }
+
+// Next-event estimation at a vertex of a path: one sample per light, and with emissive surfaces
+// one point on them (area sampling in proportion to power, MIS against the vertex's own
+// direction sampling, whose hits pt_extend weighs the other way).
+vec3 pt_direct(PathVertex v, inout RngState rng) {
   vec3 sum = vec3(0.0f);
   for (uint i = 0u; i < frame.lightCount; ++i) {
     GpuLight l = lights[i];
@@ -30,17 +49,47 @@ vec3 pt_direct(uint kind, vec3 x, vec3 rayDir, inout RngState rng) {
     vec3 w;
     float dist;
     vec3 Le;
-    if (!light_connect(l, x, light_sample_dir(l, x, rayDir, frame.g, u), w, dist, Le)) continue;
-    float pdf = light_pdf(l, w, rayDir, frame.g);
+#ifdef PLUME_HAS_SURFACES
+    if (v.kind == VERTEX_SURFACE && l.type == LIGHT_ENVIRONMENT) {
+      // A constant environment by the BSDF's own sampling (the medium's is its phase function,
+      // which light_sample_dir draws).
+      float pdf;
+      vec3 weight = vtx_at_sample(v, u, w, pdf);
+      if (pdf > 0.0f) sum += l.emission * weight * pt_shadow(v, w, DDA_INF, rng);
+      continue;
+    }
+#endif
+    if (!light_connect(l, v.x, light_sample_dir(l, v.x, v.rayDir, frame.g, u), w, dist, Le)) continue;
+    float pdf = light_pdf(l, w, v.rayDir, frame.g);
     if (!(pdf > 0.0f)) continue;  // (an all-black map)
-    float scatter = vtx_scatter(kind, rayDir, w);
+    vec3 scatter = vtx_at_scatter(v, w);
     float mis = 1.0f;
 #ifdef PLUME_HAS_ENV_MAP
-    if (l.type == LIGHT_ENV_MAP) mis = pdf * pdf / (pdf * pdf + scatter * scatter);  // p_ph = phase
+    if (l.type == LIGHT_ENV_MAP) mis = pt_power_heuristic(pdf, vtx_at_pdf(v, w));
 #endif
-    float tr = vol_ratio_tracking(x, w, dist, rng);
+    float tr = pt_shadow(v, w, dist, rng);
     sum += Le * scatter * tr * (mis / pdf);
   }
+#ifdef PLUME_HAS_EMITTERS
+  vec3 p;
+  vec3 n;
+  vec3 Le;
+  float pdfArea;
+  uvec4 h = rng_next4(rng);
+  surf_sample_emitter(vec4(rng_to_float(h.x), rng_to_float(h.y), rng_to_float(h.z), rng_to_float(h.w)), p, n, Le,
+                      pdfArea);
+  vec3 toL = p - vtx_at_origin(v, p - v.x);
+  float dist = length(toL);
+  vec3 w = toL / dist;
+  float cosLight = -dot(n, w);  // the back side emits nothing
+  vec3 scatter = vtx_at_scatter(v, w);
+  if (dist > 0.0f && cosLight > 0.0f && any(greaterThan(scatter, vec3(0.0f)))) {
+    float pdf = pdfArea * dist * dist / cosLight;  // per solid angle at the vertex
+    // Stop short of the emitter's own triangle.
+    float tr = pt_shadow(v, w, dist - surf_offset_length(p), rng);
+    sum += Le * scatter * (tr * pt_power_heuristic(pdf, vtx_at_pdf(v, w)) / pdf);
+  }
+#endif
   return sum;
 }
 
@@ -53,16 +102,18 @@ vec3 pt_escaped_map(vec3 dir, float phasePdf) {
 }
 #endif
 
-// With a map, a single-scattering path still follows its phase-sampled direction after its
-// vertex, to see whether it escapes (the map's MIS).
-#if defined(PLUME_MULTI_BOUNCE) || defined(PLUME_HAS_ENV_MAP)
+// With a map (or emissive surfaces), a single-scattering path still follows its sampled direction
+// after its vertex, to see whether it escapes to the map (or hits an emitter): their MIS.
+#if defined(PLUME_MULTI_BOUNCE) || defined(PLUME_HAS_ENV_MAP) || defined(PLUME_HAS_EMITTERS)
 #define PT_FOLLOWS_PHASE 1
 #endif
 
-// Extension (pt_extend.comp): the path in `slot` (a camera ray where `camera`) to its next real
-// collision by delta tracking, gathering the medium's emission on the way. True where the path
-// collided within max_bounces and waits for shading at its new vertex; otherwise it is finished
-// (escaped, with the environment it sees, or past max_bounces) and its radiance is final.
+// Extension (pt_extend.comp): the path in `slot` (a camera ray where `camera`) to its next
+// vertex: the medium's real collision by delta tracking (gathering its emission on the way), or
+// the first surface if that is nearer (the medium is tracked only up to it; an emissive surface
+// adds what it emits towards the path). True where the path found a vertex within max_bounces
+// and waits for shading there; otherwise it is finished (escaped, with the environment it sees,
+// or past max_bounces) and its radiance is final.
 bool pt_extend(uint slot, bool camera) {
   PtPath p;
   RngState rng = pt_slot_rng(slot, 0u);
@@ -77,47 +128,84 @@ bool pt_extend(uint slot, bool camera) {
     p.scatterings = 0u;
     p.beta = vec3(1.0f);
     p.radiance = vec3(0.0f);
+    p.prim = PT_MEDIUM_VERTEX;
+    p.shading = vec3(0.0f);
     p.pad = 0u;
   } else {
     p = ptPaths[slot];
     rng.counter = p.counter;
   }
+  float tMax = DDA_INF;
+#ifdef PLUME_HAS_SURFACES
+  BvhHit hit = bvh_closest(p.origin, p.dir, 0.0f, SURF_FAR);
+  if (hit.prim != BVH_NONE) tMax = hit.t;
+#endif
   float t;
   bool collided;
 #ifdef PLUME_HAS_EMISSION
   vec3 emitted;
-  collided = vol_sample_collision_emitting(p.origin, p.dir, DDA_INF, rng, t, emitted);
+  collided = vol_sample_collision_emitting(p.origin, p.dir, tMax, rng, t, emitted);
   // Emission along this segment: a path of `scatterings` scattering vertices, counted up to
   // max_bounces like next-event estimation's (pbrt-v4's volpath does the same).
   p.radiance += p.beta * (vec3(1.0f) - vtx_albedo(VERTEX_MEDIUM)) * emitted;
 #else
-  collided = vol_sample_collision(p.origin, p.dir, DDA_INF, rng, t);
+  collided = vol_sample_collision(p.origin, p.dir, tMax, rng, t);
 #endif
-  if (!collided) {
+  bool vertex = collided;
+  if (collided) {
+    p.origin += t * p.dir;
+    p.beta *= vtx_albedo(VERTEX_MEDIUM);  // delta tracking's collision weight
+    p.prim = PT_MEDIUM_VERTEX;
+  }
+#ifdef PLUME_HAS_SURFACES
+  else if (hit.prim != BVH_NONE) {
+    vertex = true;
+    vec3 le = surf_emitted(hit.prim, p.dir);
+#ifdef PLUME_HAS_EMITTERS
+    // After a vertex, weighted against that vertex's emitter sampling (its area density turned
+    // into solid angle at the vertex: distance² / cosine).
+    if (p.scatterings > 0u && any(greaterThan(le, vec3(0.0f)))) {
+      float pdfLight = surf_emitter_pdf(hit.prim) * hit.t * hit.t / abs(dot(surf_normal(hit.prim), p.dir));
+      le *= pt_power_heuristic(p.phasePdf, pdfLight);
+    }
+#endif
+    p.radiance += p.beta * le;
+    p.origin += hit.t * p.dir;
+    p.prim = hit.prim;
+    p.shading = surf_shading_normal(hit.prim, vec2(hit.u, hit.v), surf_normal(hit.prim));
+  }
+#endif
+  else {
     // Camera rays see every environment; after a vertex, only a map is seen (with its MIS
     // weight): the other lights are reached by NEE.
     if (p.scatterings == 0u) p.radiance += p.beta * light_escaped(p.dir);
 #ifdef PLUME_HAS_ENV_MAP
     else p.radiance += p.beta * pt_escaped_map(p.dir, p.phasePdf);
 #endif
-  } else if (++p.scatterings > frame.maxBounces) {
-    collided = false;
-  } else {
-    p.origin += t * p.dir;
-    p.beta *= vtx_albedo(VERTEX_MEDIUM);  // delta tracking's collision weight
   }
+  if (vertex && ++p.scatterings > frame.maxBounces) vertex = false;
   p.counter = rng.counter;
   ptPaths[slot] = p;
-  return collided;
+  return vertex;
+}
+
+// The vertex the path in p waits at (after pt_extend).
+PathVertex pt_vertex(PtPath p) {
+#ifdef PLUME_HAS_SURFACES
+  if (p.prim != PT_MEDIUM_VERTEX) return vtx_surface(p.origin, p.dir, p.prim, p.shading);
+#endif
+  return vtx_medium(p.origin, p.dir);
 }
 
 // Shading (pt_shade.comp) of the path in `slot` at its newest vertex: next-event estimation,
-// then (with more than one bounce, or a map to see) Russian roulette and a phase-sampled
-// direction. True where the path goes on to another extension.
+// then (with more than one bounce, or a map or emitters to see) Russian roulette and a direction
+// sampled by the vertex's phase function or BSDF. True where the path goes on to another
+// extension.
 bool pt_shade(uint slot) {
   PtPath p = ptPaths[slot];
   RngState rng = pt_slot_rng(slot, p.counter);
-  p.radiance += p.beta * pt_direct(VERTEX_MEDIUM, p.origin, p.dir, rng);
+  PathVertex v = pt_vertex(p);
+  p.radiance += p.beta * pt_direct(v, rng);
   bool more = false;
 #ifdef PT_FOLLOWS_PHASE
   more = true;
@@ -130,8 +218,13 @@ bool pt_shade(uint slot) {
     }
   }
   if (more) {
-    vec3 next = normalize(vtx_sample(VERTEX_MEDIUM, p.dir, rng_float2(rng)));
-    p.phasePdf = vtx_scatter(VERTEX_MEDIUM, p.dir, next);  // a medium vertex samples its phase exactly
+    vec3 next;
+    float pdf;
+    vec3 weight = vtx_at_sample(v, rng_float2(rng), next, pdf);
+    more = pdf > 0.0f;  // (a BSDF that produced no direction ends the path)
+    p.beta *= weight;
+    p.phasePdf = pdf;
+    p.origin = vtx_at_origin(v, next);
     p.dir = next;
   }
 #endif

@@ -19,8 +19,8 @@
 #include "../shared/pt_wave.h"
 #include "../shared/rng.h"
 
-// A path between kernels: after pt_extend, origin is its newest vertex; after pt_shade, dir is
-// the direction leaving it. counter: the draw counter of the slot's random stream (the key is a
+// A path between kernels: after pt_extend, origin is its newest vertex; after pt_shade, origin
+// and dir are the ray leaving it. counter: the draw counter of the slot's random stream (the key is a
 // hash of pixel and sample, recomputed by every kernel).
 struct PtPath {
   vec3 origin;
@@ -30,8 +30,12 @@ struct PtPath {
   vec3 beta;
   uint counter;
   vec3 radiance;
+  uint prim;     // the vertex's triangle (input index), PT_MEDIUM_VERTEX for a medium collision
+  vec3 shading;  // a surface vertex's shading normal
   uint pad;
 };
+
+const uint PT_MEDIUM_VERTEX = 0xffffffffu;
 
 layout(std430, binding = BIND_PT_PATHS) buffer PathBuffer { PtPath ptPaths[]; };
 // [0, slots): the paths to extend; [slots, 2 slots): the paths to shade.

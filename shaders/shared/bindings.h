@@ -25,6 +25,14 @@ const uint BIND_PT_PATHS = 8u;         // per path slot: 4 x vec4 (PtPath)
 const uint BIND_PT_QUEUES = 9u;        // uint[2 * slots]: the paths to extend, then those to shade
 const uint BIND_PT_WAVE = 10u;         // PtWave: queue lengths and the indirect dispatches
 
+// The scene's surfaces (shaders/surface/surfaces.glsl; render/gpu_surfaces.cpp), in the
+// estimators that render them (PLUME_HAS_SURFACES).
+const uint BIND_BVH_NODES = 11u;       // BvhNode[]
+const uint BIND_BVH_TRIANGLES = 12u;   // BvhTriangle[]
+const uint BIND_SURF_TRIANGLES = 13u;  // GpuSurfaceTriangle[], by input index
+const uint BIND_SURF_MATERIALS = 14u;  // GpuSurfaceMaterial[], by surface
+const uint BIND_EMITTERS = 15u;        // GpuEmitterAlias[]: the emissive triangles' alias table
+
 // ReSTIR (shaders/restir/bindings.glsl): its parameters, the current volume's mean field, the
 // previous frame's volume (temporal reuse evaluates the history's target with it), reservoirs.
 const uint BIND_RS_PARAMS = 7u;        // RestirParams

@@ -106,7 +106,7 @@ struct GpuFrame {
   uint rrStartBounce;    // first bounce at which Russian roulette may end a path
   uint lightCount;
   uint loopProbe;        // 2: the trip count of the driver-loop-limit probe (volume/loop_guard.glsl)
-  uint pad1;
+  uint emitterCount;     // entries of the emissive triangles' alias table (surface/surfaces.glsl)
   uint pad2;
 };
 

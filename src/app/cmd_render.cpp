@@ -10,6 +10,7 @@
 #include "media/bake.h"
 #include "media/volume_frames.h"
 #include "render/estimator.h"
+#include "render/gpu_scene.h"
 #include "render/volume_source.h"
 #include "scene/scene.h"
 
@@ -109,9 +110,9 @@ int renderFrames(const RenderArgs& a, const Scene& scene, gpu::Context& ctx, Est
 
 int runRender(const RenderArgs& a) {
   Scene scene = loadJobScene(a);
-  refuseSurfaces(scene);
   const RenderSettings& rs = scene.render;
   const EstimatorKind kind = estimatorKind(rs);
+  checkGpuSupports(scene, "--mode " + rs.mode, kind == EstimatorKind::PathTracer);  // before any output
   const EstimatorTraits& traits = estimatorTraits(kind);
   if (a.preroll > 0 && !traits.carriesHistory) {
     logInfo(strf("--preroll %d: no effect with mode %s (its frames are independent)", a.preroll, rs.mode.c_str()));

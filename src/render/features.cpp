@@ -1,5 +1,7 @@
 #include "render/features.h"
 
+#include <algorithm>
+
 namespace plume {
 
 gpu::ShaderDefines FeatureSet::defines() const {
@@ -11,6 +13,8 @@ gpu::ShaderDefines FeatureSet::defines() const {
   if (multiBounce) d.emplace_back("PLUME_MULTI_BOUNCE", "1");
   if (emission) d.emplace_back("PLUME_HAS_EMISSION", "1");
   if (blackbody) d.emplace_back("PLUME_EMISSION_BLACKBODY", "1");
+  if (surfaces) d.emplace_back("PLUME_HAS_SURFACES", "1");
+  if (emitters) d.emplace_back("PLUME_HAS_EMITTERS", "1");
   if (kernelCounters) d.emplace_back("PLUME_KERNEL_COUNTERS", "1");
   return d;
 }
@@ -28,6 +32,8 @@ std::string FeatureSet::name() const {
   add(envMap, "envmap");
   add(multiBounce, "multi");
   add(emission, blackbody ? "blackbody" : "emission");
+  add(surfaces, "surfaces");
+  add(emitters, "emitters");
   add(kernelCounters, "counters");
   return n.empty() ? "none" : n;
 }
@@ -44,6 +50,8 @@ FeatureSet featuresOf(const Scene& scene) {
     f.emission |= m.emission.has_value();
     f.blackbody |= m.emission && m.emission->blackbody;
   }
+  f.surfaces = !scene.surfaces.empty();
+  f.emitters = std::any_of(scene.surfaces.begin(), scene.surfaces.end(), [](const Surface& s) { return s.emits(); });
   // With emission a path also gathers light along the segment after its last scattering, so one
   // bounce already needs the path loop.
   f.multiBounce = scene.render.maxBounces > 1 || (f.emission && scene.render.maxBounces >= 1);

@@ -17,6 +17,7 @@ struct FeatureSet {
   // environment: any environment light (a constant one or a map); envMap: one with a map.
   bool sun = false, point = false, environment = false, envMap = false, multiBounce = false;
   bool emission = false, blackbody = false;  // the medium emits (blackbody: its colour form)
+  bool surfaces = false, emitters = false;   // the scene has surfaces (emitters: some emit)
   // The kernel benchmark's event counters in the walk (shared/kernel_counters.h): never a scene
   // feature, set only by `plume bench --kernels` (EstimatorOptions::kernelCounters).
   bool kernelCounters = false;

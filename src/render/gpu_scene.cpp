@@ -9,8 +9,11 @@
 
 namespace plume {
 
-void checkGpuSupports(const Scene& scene, const std::string& renderer) {
-  refuseSurfaces(scene);  // no estimator renders them yet (issue 12)
+void checkGpuSupports(const Scene& scene, const std::string& renderer, bool rendersSurfaces) {
+  if (!rendersSurfaces && !scene.surfaces.empty()) {
+    throw InputError(scene.path + ": surfaces: " + renderer +
+                     " does not render surfaces yet (issue 12): use --mode pt, or plume reference");
+  }
 }
 
 std::vector<shared::GpuLight> gpuLights(const Scene& scene) {

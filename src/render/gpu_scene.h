@@ -13,9 +13,9 @@
 
 namespace plume {
 
-// Throws InputError naming the scene key for features the GPU renderers lack (surfaces);
-// `renderer` names the renderer in the message.
-void checkGpuSupports(const Scene& scene, const std::string& renderer);
+// Throws InputError naming the scene key for features a GPU renderer lacks (surfaces, where
+// !rendersSurfaces); `renderer` names the renderer in the message.
+void checkGpuSupports(const Scene& scene, const std::string& renderer, bool rendersSurfaces = false);
 
 // The scene's lights for the shaders (never empty: one zero light when the scene has none).
 // Throws InputError for more than GPU_MAX_LIGHTS lights.

@@ -21,8 +21,9 @@ PathTracer::PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const S
     : ctx_(ctx), scene_(scene), features_(featuresOf(scene)), compiler_(compiler),
       timer_(ctx, 2 * kBouncesPerSubmit) {
   features_.kernelCounters = kernelCounters;
-  checkGpuSupports(scene, "the GPU path tracer");
+  checkGpuSupports(scene, "the GPU path tracer", true);
   envMap_ = std::make_unique<GpuEnvironmentMap>(ctx, scene);
+  if (features_.surfaces) surfaces_ = std::make_unique<GpuSurfaces>(ctx, scene);
   const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   const size_t pixels = size_t(scene.camera.width) * scene.camera.height;
   frameBuffer_ = gpu::Buffer(ctx, sizeof(shared::GpuFrame), storage, "frame parameters");
@@ -31,7 +32,7 @@ PathTracer::PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const S
   lightBuffer_.upload(lights.data(), lights.size() * sizeof(shared::GpuLight));
   accum_ = gpu::Buffer(ctx, pixels * 2 * sizeof(glm::vec4), storage, "accumulation");
   slots_ = uint32_t(std::min<size_t>(pixels, kMaxSlots));
-  paths_ = gpu::Buffer(ctx, size_t(slots_) * 4 * sizeof(glm::vec4), storage, "path slots");
+  paths_ = gpu::Buffer(ctx, size_t(slots_) * shared::PT_PATH_BYTES, storage, "path slots");
   queues_ = gpu::Buffer(ctx, size_t(slots_) * 2 * sizeof(uint32_t), storage, "path queues");
   wave_ = gpu::Buffer(ctx, sizeof(shared::PtWave), storage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, "path queue lengths");
   const gpu::ShaderDefines none;
@@ -65,6 +66,7 @@ std::unique_ptr<gpu::ComputePass> PathTracer::makePass(const std::string& file, 
   if (volumeTable) {
     pass->set.bind(shared::BIND_LIGHTS, lightBuffer_);
     envMap_->bind(pass->set);
+    if (surfaces_) surfaces_->bind(pass->set);
   }
   return pass;
 }
@@ -94,6 +96,7 @@ void PathTracer::setVolume(const GpuVolumeResources& volume) {
 
 void PathTracer::beginFrame(int frame) {
   frame_ = gpuFrame(scene_, frame, uint32_t(scene_.render.seed), uint32_t(frame), 1u);
+  frame_.emitterCount = surfaces_ ? surfaces_->emitterCount() : 0u;
   accum_.fillZero();
   samples_ = 0;
 }

@@ -11,6 +11,7 @@
 #include "io/image.h"
 #include "render/features.h"
 #include "render/gpu_envmap.h"
+#include "render/gpu_surfaces.h"
 #include "render/gpu_volume.h"
 #include "scene/scene.h"
 
@@ -25,6 +26,7 @@ class PathTracer {
   PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene, bool kernelCounters = false);
 
   const FeatureSet& features() const { return features_; }
+  bool hasSurfaces() const { return surfaces_ != nullptr; }  // a BVH was built (the scene has surfaces)
   // Binds a volume; call again when the volume changes (animation). Large brick grids use the
   // empty-space-skipping variant of the tracking code (compiled on first use).
   void setVolume(const GpuVolumeResources& volume);
@@ -48,6 +50,7 @@ class PathTracer {
   const Scene& scene_;
   FeatureSet features_;
   std::unique_ptr<GpuEnvironmentMap> envMap_;
+  std::unique_ptr<GpuSurfaces> surfaces_;  // only for a scene with surfaces
   struct Tracking {  // the kernels that walk the volume, per variant
     std::unique_ptr<gpu::ComputePass> extend, shade;
   };

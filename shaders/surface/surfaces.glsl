@@ -1,0 +1,87 @@
+// The scene's surfaces as the estimators see them (DESIGN §2 "Surfaces", §4.3): the BVH's
+// bindings and traversal (surface/bvh.glsl), a hit's normals and material, emission leaving a
+// triangle's front side, the emissive triangles as one light sampled by area in proportion to
+// power (an alias table), and ray origins pushed off a surface. Compiled only into scenes with
+// surfaces (PLUME_HAS_SURFACES; PLUME_HAS_EMITTERS where some surface emits). The host side is
+// render/gpu_surfaces.cpp; the CPU reference's own version is reference/surfaces.cpp.
+// Requires scene/bindings.glsl.
+#ifndef PLUME_SURFACE_SURFACES_GLSL
+#define PLUME_SURFACE_SURFACES_GLSL
+
+#include "../shared/bvh.h"
+#include "../shared/surface_types.h"
+
+layout(std430, binding = BIND_BVH_NODES) readonly buffer BvhNodeBuffer { BvhNode bvhNodes[]; };
+layout(std430, binding = BIND_BVH_TRIANGLES) readonly buffer BvhTriangleBuffer { BvhTriangle bvhTriangles[]; };
+#define BVH_NODE(i) bvhNodes[i]
+#define BVH_TRIANGLE(i) bvhTriangles[i]
+#include "bvh.glsl"
+
+layout(std430, binding = BIND_SURF_TRIANGLES) readonly buffer SurfTriangleBuffer { GpuSurfaceTriangle surfTriangles[]; };
+layout(std430, binding = BIND_SURF_MATERIALS) readonly buffer SurfMaterialBuffer { GpuSurfaceMaterial surfMaterials[]; };
+#ifdef PLUME_HAS_EMITTERS
+layout(std430, binding = BIND_EMITTERS) readonly buffer EmitterBuffer { GpuEmitterAlias surfEmitters[]; };
+#endif
+
+const float SURF_FAR = 3.0e38f;
+// Ray origins leave a surface this far, relative to the point's magnitude (float traversal).
+const float SURF_RELATIVE_OFFSET = 1e-4f;
+
+// The unit geometric normal of the triangle's front side (counter-clockwise seen from it).
+vec3 surf_normal(uint prim) {
+  GpuSurfaceTriangle t = surfTriangles[prim];
+  return normalize(cross(t.v1 - t.v0, t.v2 - t.v0));
+}
+
+// The shading normal at barycentrics uv (Embree's: p = (1 - u - v) v0 + u v1 + v v2): the mesh's
+// interpolated normals where it has them, else the geometric normal.
+vec3 surf_shading_normal(uint prim, vec2 uv, vec3 geometric) {
+  GpuSurfaceTriangle t = surfTriangles[prim];
+  if (t.hasNormals == 0u) return geometric;
+  vec3 n = (1.0f - uv.x - uv.y) * t.n0 + uv.x * t.n1 + uv.y * t.n2;
+  float len = length(n);
+  return len > 0.0f ? n / len : geometric;
+}
+
+Bsdf surf_bsdf(uint prim) { return surfMaterials[surfTriangles[prim].surface].bsdf; }
+
+// The radiance a ray of direction dir sees where it hits triangle prim: the surface's emission
+// on the front side, nothing on the back.
+vec3 surf_emitted(uint prim, vec3 dir) {
+  return dot(surf_normal(prim), dir) < 0.0f ? surfMaterials[surfTriangles[prim].surface].emission : vec3(0.0f);
+}
+
+float surf_offset_length(vec3 p) { return SURF_RELATIVE_OFFSET * (1.0f + plume_max3(abs(p))); }
+
+// A ray's origin at surface point p (geometric normal n) towards w: pushed off to w's side, so
+// that the next traversal cannot find the same triangle.
+vec3 surf_offset_origin(vec3 p, vec3 n, vec3 w) {
+  return p + ((dot(n, w) < 0.0f ? -1.0f : 1.0f) * surf_offset_length(p)) * n;
+}
+
+// Whether a surface lies on the ray within (0, tMax) (shadow rays).
+bool surf_occluded(vec3 o, vec3 d, float tMax) { return bvh_any(o, d, 0.0f, tMax); }
+
+#ifdef PLUME_HAS_EMITTERS
+// The area density with which surf_sample_emitter picks a point of triangle prim (0: it is dark).
+float surf_emitter_pdf(uint prim) { return surfTriangles[prim].lightPdf; }
+
+// A point on the emissive triangles (u in [0,1)⁴: the table entry, its coin, then the point):
+// its position, front normal, radiance and area density.
+void surf_sample_emitter(vec4 u, out vec3 p, out vec3 n, out vec3 Le, out float pdfArea) {
+  uint i = min(uint(u.x * float(frame.emitterCount)), frame.emitterCount - 1u);
+  GpuEmitterAlias e = surfEmitters[i];
+  uint prim = u.y < e.keep ? e.triangle : surfEmitters[e.alias].triangle;
+  GpuSurfaceTriangle t = surfTriangles[prim];
+  // Uniform in the triangle (the square-root map, as the reference).
+  float r = sqrt(u.z);
+  float b1 = r * (1.0f - u.w);
+  float b2 = r * u.w;
+  p = (1.0f - b1 - b2) * t.v0 + b1 * t.v1 + b2 * t.v2;
+  n = normalize(cross(t.v1 - t.v0, t.v2 - t.v0));
+  Le = surfMaterials[t.surface].emission;
+  pdfArea = t.lightPdf;
+}
+#endif
+
+#endif

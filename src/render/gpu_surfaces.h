@@ -1,0 +1,35 @@
+// The scene's surfaces on the device (DESIGN §4.3; shaders/surface/surfaces.glsl): the triangles
+// loaded and transformed (geometry/scene_mesh.h), Embree's BVH flattened (geometry/bvh.h), each
+// input triangle's vertices, shading normals, surface and light density, the surfaces' materials,
+// and an alias table over the emissive triangles (chosen in proportion to power: area times the
+// mean of Le's channels, as the CPU reference). Built only for scenes with surfaces.
+#pragma once
+
+#include "geometry/bvh.h"
+#include "gpu/pipeline.h"
+#include "scene/scene.h"
+
+#include <cstdint>
+
+namespace plume {
+
+class GpuSurfaces {
+ public:
+  // Throws InputError for bad surfaces (an OBJ's file and line, a scene key) and for a mesh
+  // larger than the device's storage buffers allow (the message names the buffer).
+  GpuSurfaces(gpu::Context& ctx, const Scene& scene);
+
+  // Binds BIND_BVH_NODES .. BIND_EMITTERS.
+  void bind(gpu::DescriptorSet& set) const;
+  uint32_t emitterCount() const { return emitterCount_; }
+  const geo::BvhStats& bvhStats() const { return stats_; }
+  double uploadMs() const { return uploadMs_; }
+
+ private:
+  gpu::Buffer nodes_, bvhTriangles_, triangles_, materials_, emitters_;
+  uint32_t emitterCount_ = 0;
+  geo::BvhStats stats_;
+  double uploadMs_ = 0.0;
+};
+
+}  // namespace plume

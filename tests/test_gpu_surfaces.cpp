@@ -1,0 +1,182 @@
+// Surfaces in the GPU path tracer (issue 12; DESIGN §4.3): closed forms where the estimator is
+// exact (a diffuse plane under a sun, an emitter seen directly, front and back), the per-pixel
+// and aggregate Z-tests against the CPU reference (which intersects with Embree itself, not the
+// flattened tree) on smoke over a ground, an occluder and a glossy conductor, and emissive quads
+// as the only lights; and a scene without surfaces compiles no traversal and builds no BVH.
+#include "reference/reference.h"
+#include "render/features.h"
+#include "render/path_tracer.h"
+#include "shaders/shared/bindings.h"
+#include "support/gpu_fixture.h"
+#include "support/grids.h"
+#include "support/reference_check.h"
+#include "support/scenes.h"
+
+#include <glm/glm.hpp>
+
+#include <cmath>
+
+using namespace plume;
+
+namespace {
+
+class GpuSurfaceTest : public test::GpuTest {};
+
+Surface plane(glm::vec3 centre, glm::vec3 normal, glm::vec2 size) {
+  Surface s;
+  s.plane = SurfacePlane{centre, normal, size};
+  return s;
+}
+
+Surface emitter(glm::vec3 centre, glm::vec3 normal, glm::vec2 size, glm::vec3 radiance) {
+  Surface s = plane(centre, normal, size);
+  s.albedo = glm::vec3(0.0f);
+  s.emission = radiance;
+  return s;
+}
+
+// The noise cloud (about [0, 2]³) over a ground plane at y = 0, seen from the front.
+Scene groundScene(int size, int bounces) {
+  Scene s;
+  s.path = "surface-scene";
+  s.camera.base.position = {1.0f, 1.4f, 4.6f};
+  s.camera.base.lookAt = {1.0f, 0.7f, 1.0f};
+  s.camera.base.fovY = 40.0f;
+  s.camera.width = s.camera.height = size;
+  s.media.push_back(Medium{});
+  s.medium().densityScale = 3.0f;
+  s.medium().albedo = glm::vec3(0.9f);
+  s.medium().g = 0.3f;
+  s.lights = {test::sunLight({0.5f, 1.0f, 0.3f}, {3.0f, 2.8f, 2.5f}), test::skyLight({0.10f, 0.12f, 0.16f})};
+  Surface ground = plane({1.0f, 0.0f, 1.0f}, {0, 1, 0}, {8.0f, 8.0f});
+  ground.albedo = glm::vec3(0.6f, 0.5f, 0.4f);
+  s.surfaces.push_back(ground);
+  s.render.maxBounces = bounces;
+  return s;
+}
+
+Image reference(Scene s, openvdb::FloatGrid::Ptr grid, int spp) {
+  s.render.spp = spp;
+  s.render.seed = 4242;
+  ref::ReferenceOptions opt;
+  opt.progress = false;
+  return ref::renderReference(s, grid, opt);
+}
+
+void renderAndCompare(gpu::Context& ctx, gpu::ShaderCompiler& compiler, Scene s, openvdb::FloatGrid::Ptr grid,
+                      int gpuSpp, int refSpp, const std::string& name) {
+  const Image refImage = reference(s, grid, refSpp);
+  s.render.spp = gpuSpp;
+  test::GpuRenderInfo info;
+  const Image gpuImage = test::renderGpuPt(ctx, compiler, s, grid, 1, &info);
+  EXPECT_NE(info.variant.find("surfaces"), std::string::npos) << info.variant;
+  EXPECT_EQ(info.truncated, 0u) << name;
+  test::ReferenceCheckOptions options;
+  options.outputGroup = "gpu_surfaces";
+  test::expectMatchesReference(gpuImage, refImage, name, options);
+}
+
+// SPIR-V decorates a descriptor binding as OpDecorate (opcode 71) <id> Binding (33) <n>.
+bool declaresBinding(const std::vector<uint32_t>& spirv, uint32_t binding) {
+  for (size_t i = 5; i < spirv.size();) {
+    const uint32_t words = spirv[i] >> 16, opcode = spirv[i] & 0xffffu;
+    if (words == 0) break;
+    if (opcode == 71 && words >= 4 && spirv[i + 2] == 33 && spirv[i + 3] == binding) return true;
+    i += words;
+  }
+  return false;
+}
+
+}  // namespace
+
+// No medium (an empty grid), a delta sun, one bounce: every sample that sees the plane returns
+// exactly L = rho E cos(theta) / pi (next-event estimation is deterministic here), the others 0,
+// so each pixel holds L times the fraction of its samples that hit the plane (1 below the horizon).
+TEST_F(GpuSurfaceTest, DiffusePlaneUnderASunIsRhoECosOverPi) {
+  Scene s = groundScene(24, 1);
+  s.lights = {test::sunLight({0.3f, 1.0f, -0.2f}, {2.0f, 3.0f, 4.0f})};
+  s.render.spp = 4;
+  const Image img = test::renderGpuPt(ctx(), compiler(), s, openvdb::FloatGrid::create());
+  const glm::vec3 rho = s.surfaces[0].albedo;
+  const float cosTheta = glm::normalize(glm::vec3(0.3f, 1.0f, -0.2f)).y;
+  const glm::vec3 expected = rho * glm::vec3(2.0f, 3.0f, 4.0f) * cosTheta / float(M_PI);
+  int full = 0;
+  for (int y = 0; y < img.height; ++y) {
+    for (int x = 0; x < img.width; ++x) {
+      const glm::vec3 p = img.pixel(x, y);
+      const float hits = std::round(p.x / expected.x * float(s.render.spp));
+      ASSERT_GE(hits, 0.0f);
+      ASSERT_LE(hits, float(s.render.spp));
+      full += hits == float(s.render.spp);
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_NEAR(p[c], expected[c] * hits / float(s.render.spp), 1e-5f * expected[c]) << x << "," << y << " channel " << c;
+      }
+    }
+  }
+  EXPECT_GT(full, img.width * img.height / 3);  // the lower part of the image
+}
+
+// An emitter seen directly returns its radiance from the front and nothing from the back.
+TEST_F(GpuSurfaceTest, EmitterSeenDirectlyFrontAndBack) {
+  for (const float side : {1.0f, -1.0f}) {
+    Scene s = groundScene(16, 1);
+    s.lights.clear();
+    s.surfaces = {emitter(s.camera.base.lookAt, side * (s.camera.base.position - s.camera.base.lookAt), {20.0f, 20.0f},
+                          {1.5f, 2.5f, 3.5f})};
+    s.render.spp = 2;
+    const Image img = test::renderGpuPt(ctx(), compiler(), s, openvdb::FloatGrid::create());
+    const glm::vec3 expected = side > 0.0f ? glm::vec3(1.5f, 2.5f, 3.5f) : glm::vec3(0.0f);
+    for (int y = 0; y < img.height; ++y)
+      for (int x = 0; x < img.width; ++x) ASSERT_EQ(img.pixel(x, y), expected) << x << "," << y << " side " << side;
+  }
+}
+
+// Smoke over a diffuse ground under sun and sky: the smoke's shadow on the ground, the ground's
+// light bounced into the smoke.
+TEST_F(GpuSurfaceTest, SmokeOverGroundMatchesReference) {
+  renderAndCompare(ctx(), compiler(), groundScene(24, 4), test::makeNoiseGrid(32, 1.0 / 16, 3), 512, 1024,
+                   "smoke_over_ground");
+}
+
+// An occluding quad between the sun and the smoke, and a glossy conductor quad beside it.
+TEST_F(GpuSurfaceTest, OccluderAndGlossyConductorMatchReference) {
+  Scene s = groundScene(24, 4);
+  Surface occluder = plane({1.4f, 2.6f, 1.2f}, {0.2f, 1.0f, 0.1f}, {1.0f, 1.0f});
+  occluder.albedo = glm::vec3(0.3f);
+  Surface metal = plane({2.4f, 0.8f, 0.4f}, {-1.0f, 0.2f, 0.6f}, {1.2f, 1.4f});
+  metal.material = SurfaceMaterial::Conductor;
+  metal.roughness = 0.3f;
+  metal.f0 = glm::vec3(0.95f, 0.64f, 0.54f);
+  s.surfaces.push_back(occluder);
+  s.surfaces.push_back(metal);
+  renderAndCompare(ctx(), compiler(), s, test::makeNoiseGrid(32, 1.0 / 16, 5), 512, 1024, "occluder_and_conductor");
+}
+
+// Emissive quads as the only lights (light sampling by area in proportion to power, BSDF and
+// phase sampling hitting them, combined by MIS), with a back-facing one that must stay dark.
+TEST_F(GpuSurfaceTest, EmissiveQuadsAsTheOnlyLightsMatchReference) {
+  Scene s = groundScene(24, 3);
+  s.lights.clear();
+  s.surfaces.push_back(emitter({0.2f, 2.4f, 1.0f}, {0.3f, -1.0f, 0.0f}, {0.5f, 0.5f}, {12.0f, 9.0f, 6.0f}));
+  s.surfaces.push_back(emitter({1.8f, 2.2f, 0.6f}, {-0.2f, -1.0f, 0.3f}, {0.3f, 0.6f}, {4.0f, 6.0f, 12.0f}));
+  s.surfaces.push_back(emitter({1.0f, 0.02f, 2.6f}, {0.0f, -1.0f, 0.0f}, {0.6f, 0.6f}, {50.0f, 50.0f, 50.0f}));
+  renderAndCompare(ctx(), compiler(), s, test::makeNoiseGrid(32, 1.0 / 16, 7), 1024, 2048, "emissive_quads");
+}
+
+// DESIGN §5: a scene without surfaces compiles no traversal (no BVH binding in its kernels) and
+// builds no BVH; with surfaces both kernels bind it.
+TEST_F(GpuSurfaceTest, ASceneWithoutSurfacesCompilesNoTraversal) {
+  Scene with = groundScene(8, 2);
+  Scene without = with;
+  without.surfaces.clear();
+  EXPECT_FALSE(featuresOf(without).surfaces);
+  EXPECT_TRUE(featuresOf(with).surfaces);
+  for (const char* kernel : {"passes/pt_extend.comp", "passes/pt_shade.comp"}) {
+    EXPECT_FALSE(declaresBinding(compiler().compile(kernel, featuresOf(without).defines()), shared::BIND_BVH_NODES))
+        << kernel;
+    EXPECT_TRUE(declaresBinding(compiler().compile(kernel, featuresOf(with).defines()), shared::BIND_BVH_NODES))
+        << kernel;
+  }
+  EXPECT_FALSE(PathTracer(ctx(), compiler(), without).hasSurfaces());
+  EXPECT_TRUE(PathTracer(ctx(), compiler(), with).hasSurfaces());
+}
