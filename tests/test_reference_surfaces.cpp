@@ -1,6 +1,7 @@
 // The CPU reference with surfaces (issue 12), against closed forms:
 //  - a diffuse plane under a sun, no medium: every pixel is rho E cos(theta) / pi (the estimator is
-//    deterministic there: one NEE, and the bounce escapes into a black sky);
+//    deterministic there: one NEE, and the bounce escapes into a black sky), and exactly 0 in the
+//    shadow of a black square;
 //  - an emissive quad seen directly is exactly its radiance from the front, black from the back;
 //  - an emissive square lighting a diffuse ground: each pixel against rho Le F, F the closed-form
 //    form factor from a point to a parallel rectangle, averaged over the pixel's footprint; with
@@ -85,10 +86,13 @@ dvec3 groundPoint(const Scene& s, double x, double y, double height = 0.0) {
 
 }  // namespace
 
-TEST(ReferenceSurfaces, DiffusePlaneUnderSunIsRhoECosOverPi) {
+TEST(ReferenceSurfaces, DiffusePlaneUnderSunIsRhoECosOverPiOutsideAnOccludersShadow) {
   Scene s = sceneLookingAt({0.3f, 2.0f, 2.0f}, {0.0f, 0.0f, 0.0f}, {0, 1, 0}, 30.0f, 16);
   const glm::vec3 albedo(0.3f, 0.5f, 0.7f);
   s.surfaces.push_back(plane({0, 0, 0}, {0, 1, 0}, {100, 100}, albedo));
+  // A black square at height 3, above the camera (out of its view), whose shadow along the sun
+  // (0.4, 1, 0.3) is the square [-0.5, 0.5]^2 of the ground.
+  s.surfaces.push_back(plane({1.2f, 3.0f, 0.9f}, {0, -1, 0}, {1, 1}, glm::vec3(0.0f)));
   Light sun;
   sun.type = LightType::Sun;
   sun.toLight = glm::normalize(glm::vec3(0.4f, 1.0f, 0.3f));
@@ -98,16 +102,27 @@ TEST(ReferenceSurfaces, DiffusePlaneUnderSunIsRhoECosOverPi) {
   s.render.spp = 4;
   const Image img = render(s, noMedium());
   const double cosTheta = glm::normalize(dvec3(0.4, 1.0, 0.3)).y;
-  for (int c = 0; c < 3; ++c) {
-    const double expected = double(albedo[c]) * sun.irradiance[c] * cosTheta / M_PI;
-    for (int py = 0; py < img.height; ++py) {
-      for (int px = 0; px < img.width; ++px) {
+  int lit = 0, shadowed = 0;
+  for (int py = 0; py < img.height; ++py) {
+    for (int px = 0; px < img.width; ++px) {
+      // A pixel is wholly in the shadow, or wholly out of it, when its footprint's corners are.
+      int inside = 0;
+      for (int corner = 0; corner < 4; ++corner) {
+        const dvec3 p = groundPoint(s, px + (corner & 1), py + (corner >> 1));
+        inside += std::abs(p.x) < 0.5 && std::abs(p.z) < 0.5;
+      }
+      if (inside != 0 && inside != 4) continue;
+      ++(inside == 4 ? shadowed : lit);
+      for (int c = 0; c < 3; ++c) {
         const size_t i = (size_t(py) * img.width + px) * 3 + size_t(c);
+        const double expected = inside == 4 ? 0.0 : double(albedo[c]) * sun.irradiance[c] * cosTheta / M_PI;
         ASSERT_NEAR(img.rgb[i], expected, 1e-6 * expected) << "pixel " << px << "," << py << " channel " << c;
         ASSERT_LE(img.var[i], 1e-12 * expected * expected);
       }
     }
   }
+  EXPECT_GT(lit, 50);
+  EXPECT_GT(shadowed, 20);
 }
 
 TEST(ReferenceSurfaces, EmissiveQuadSeenDirectlyIsItsRadianceFromTheFrontOnly) {
