@@ -9,10 +9,12 @@
 //    agree with it and with each other, also on a glossy conductor where no closed form exists);
 //  - smoke over a plane: finite, the ground darker in the smoke's shadow than in the sun, and a
 //    brighter ground brightens the smoke (light bounced into it).
+#include "geometry/bvh.h"
 #include "reference/reference.h"
 #include "support/grids.h"
 #include "support/reference_check.h"
 #include "support/test_support.h"
+#include "io/image.h"
 
 #include <glm/glm.hpp>
 #include <gtest/gtest.h>
@@ -52,11 +54,11 @@ Surface emitter(glm::vec3 centre, glm::vec3 normal, glm::vec2 size, glm::vec3 ra
 openvdb::FloatGrid::ConstPtr noMedium() { return openvdb::FloatGrid::create(0.0f); }
 
 Image render(const Scene& scene, openvdb::FloatGrid::ConstPtr grid,
-             ref::EmitterStrategy strategy = ref::EmitterStrategy::Mis) {
+             ref::EmitterStrategy strategy = ref::EmitterStrategy::Mis, ref::ReferenceStats* stats = nullptr) {
   ref::ReferenceOptions opt;
   opt.progress = false;
   opt.emitterStrategy = strategy;
-  return ref::renderReference(scene, grid, opt);
+  return ref::renderReference(scene, grid, opt, stats);
 }
 
 test::ReferenceCheckOptions checkOptions() {
@@ -313,4 +315,32 @@ TEST(ReferenceSurfaces, SmokeShadowsTheGroundAndTheGroundLightsTheSmoke) {
     var += double(bright.var[i]) + dark.var[i];
   }
   EXPECT_GT(difference, 4.0 * std::sqrt(var)) << "difference " << difference << " standard error " << std::sqrt(var);
+}
+
+TEST(ReferenceSurfaces, ASceneWithoutSurfacesBuildsNoEmbreeScene) {
+  SmokeOverGround g(0.5f);
+  g.scene.render.spp = 1;
+  ref::ReferenceStats stats;
+  size_t before = geo::EmbreeScene::built();
+  Image img = render(g.scene, g.grid, ref::EmitterStrategy::Mis, &stats);
+  EXPECT_EQ(geo::EmbreeScene::built(), before + 1) << "the counter counts";
+  EXPECT_EQ(stats.surfaceTriangles, 2u);
+  EXPECT_EQ(img.meta["surface_triangles"], "2");
+
+  g.scene.surfaces.clear();
+  before = geo::EmbreeScene::built();
+  img = render(g.scene, g.grid, ref::EmitterStrategy::Mis, &stats);
+  EXPECT_EQ(geo::EmbreeScene::built(), before);
+  EXPECT_EQ(stats.surfaceTriangles, 0u);
+  EXPECT_EQ(img.meta.count("surface_triangles"), 0u);
+}
+
+TEST(ReferenceSurfaces, BundledSmokeOverGroundRendersFromTheCommandLine) {
+  const std::string out = test::outputDir("reference_surfaces_cli") + "/ground.exr";
+  const test::RunResult r = test::runPlume({"reference", test::sourcePath("volumes/smoke/smoke_ground.json"), "-o", out,
+                                            "--frames", "12", "--width", "16", "--height", "16", "--spp", "2", "-q"});
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  Image img = readExr(out);
+  EXPECT_EQ(img.meta["surface_triangles"], "2210");  // the plane's 2 and the sphere's 2208
+  for (float v : img.rgb) ASSERT_TRUE(std::isfinite(v));
 }

@@ -427,6 +427,10 @@ Image renderReference(const Scene& scene, openvdb::FloatGrid::ConstPtr density,
   stats.samples = uint64_t(cam.width) * cam.height * rs.spp;
   stats.truncatedTracking = tracking.truncated.load();
   stats.trackingSteps = tracking.steps.load();
+  if (surfaces) {
+    stats.surfaceTriangles = surfaces->triangleCount();
+    stats.emissiveTriangles = surfaces->emitterCount();
+  }
   if (stats.truncatedTracking > 0) {
     logWarn(strf("frame %d: %llu tracking loops hit the step cap (%llu steps) and were truncated",
                  options.frame, (unsigned long long)stats.truncatedTracking,
@@ -438,6 +442,10 @@ Image renderReference(const Scene& scene, openvdb::FloatGrid::ConstPtr density,
   image.meta["samples_per_s"] = strf("%.0f", stats.samplesPerSecond());
   image.meta["tracking_truncated"] = std::to_string(stats.truncatedTracking);
   image.meta["tracking_steps"] = std::to_string(stats.trackingSteps);
+  if (surfaces) {
+    image.meta["surface_triangles"] = std::to_string(stats.surfaceTriangles);
+    image.meta["emissive_triangles"] = std::to_string(stats.emissiveTriangles);
+  }
   if (statsOut) *statsOut = stats;
   return image;
 }

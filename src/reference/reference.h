@@ -42,6 +42,8 @@ struct ReferenceStats {
   uint64_t samples = 0;           // camera paths
   uint64_t truncatedTracking = 0; // tracking loops stopped by the step cap (should be 0)
   uint64_t trackingSteps = 0;
+  size_t surfaceTriangles = 0;    // 0: no surfaces (and no Embree scene)
+  size_t emissiveTriangles = 0;
   double samplesPerSecond() const { return seconds > 0 ? samples / seconds : 0; }
 };
 

@@ -52,6 +52,7 @@ class ReferenceSurfaces {
   // side, 0 on the back (DESIGN §2).
   glm::dvec3 emitted(const SurfaceHit& hit, const glm::dvec3& dir) const;
 
+  size_t triangleCount() const { return normals_.size(); }
   bool hasEmitters() const { return !emitters_.empty(); }
   size_t emitterCount() const { return emitters_.size(); }
   // A point on an emissive triangle (u in [0, 1)^3: one for the triangle, two inside it).
