@@ -12,7 +12,8 @@
 namespace volgen {
 
 int runMesh(const MeshParams& p) {
-  if (p.rings < 2 || p.segments < 3 || !(p.radius > 0.0)) throw std::runtime_error("mesh: needs rings >= 2, segments >= 3, radius > 0");
+  if (p.rings < 2 || p.segments < 3 || !(p.radius > 0.0))
+    throw std::runtime_error("mesh: needs rings >= 2, segments >= 3, radius > 0");
   const std::filesystem::path out(p.out);
   if (out.has_parent_path()) std::filesystem::create_directories(out.parent_path());
   FILE* f = std::fopen(p.out.c_str(), "w");
@@ -22,7 +23,8 @@ int runMesh(const MeshParams& p) {
   // Vertices: the two poles, then rings 1 .. rings-1 from the top, `segments` each.
   const double pi = 3.14159265358979323846;
   auto vertex = [&](double nx, double ny, double nz) {
-    std::fprintf(f, "v %.5f %.5f %.5f\n", p.centre[0] + p.radius * nx, p.centre[1] + p.radius * ny, p.centre[2] + p.radius * nz);
+    std::fprintf(f, "v %.5f %.5f %.5f\n", p.centre[0] + p.radius * nx, p.centre[1] + p.radius * ny,
+                 p.centre[2] + p.radius * nz);
     std::fprintf(f, "vn %.5f %.5f %.5f\n", nx, ny, nz);
   };
   vertex(0, 1, 0);
@@ -47,7 +49,8 @@ int runMesh(const MeshParams& p) {
   }
   const bool ok = std::ferror(f) == 0;
   if (std::fclose(f) != 0 || !ok) throw std::runtime_error("cannot write " + p.out);
-  std::printf("%s: %d vertices, %d triangles\n", p.out.c_str(), 2 + (p.rings - 1) * p.segments, 2 * p.segments * (p.rings - 1));
+  std::printf("%s: %d vertices, %d triangles\n", p.out.c_str(), 2 + (p.rings - 1) * p.segments,
+              2 * p.segments * (p.rings - 1));
   return 0;
 }
 
