@@ -34,6 +34,9 @@ int runReference(const ReferenceArgs& a) {
   const RenderSettings& rs = scene.render;
   a.outputs.check(rs);
   checkVolumeFrames(scene, rs.frameFirst, rs.frameLast);
+  // Surfaces are loaded and built once, before the first frame (bad OBJs fail with nothing written).
+  std::shared_ptr<const ref::ReferenceSurfaces> surfaces;
+  if (!scene.surfaces.empty()) surfaces = std::make_shared<const ref::ReferenceSurfaces>(scene);
   const Medium& medium = scene.medium();
   for (int frame = rs.frameFirst; frame <= rs.frameLast; ++frame) {
     const RenderKey key = referenceRenderKey(scene, frame);
@@ -47,6 +50,7 @@ int runReference(const ReferenceArgs& a) {
     if (grid.clampedValues > 0) warnClamped(grid, medium.densityScale);
     ref::ReferenceOptions opt;
     opt.frame = frame;
+    opt.surfaces = surfaces;
     opt.progress = !a.quiet;
     ref::ReferenceStats stats;
     Image image = ref::renderReference(scene, grid.grid, opt, &stats);

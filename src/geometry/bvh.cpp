@@ -10,6 +10,7 @@
 #include <embree3/rtcore.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -307,7 +308,14 @@ struct EmbreeScene::Impl {
   RTCScene scene = nullptr;
 };
 
+namespace {
+std::atomic<size_t> embreeScenesBuilt{0};
+}  // namespace
+
+size_t EmbreeScene::built() { return embreeScenesBuilt.load(); }
+
 EmbreeScene::EmbreeScene(const TriangleMesh& mesh) : impl_(std::make_unique<Impl>()) {
+  ++embreeScenesBuilt;
   RTCDevice dev = device();
   impl_->scene = rtcNewScene(dev);
   rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);

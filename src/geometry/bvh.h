@@ -49,6 +49,8 @@ class EmbreeScene {
  public:
   explicit EmbreeScene(const TriangleMesh& mesh);
   ~EmbreeScene();
+  // Embree scenes constructed so far in this process (a scene without surfaces must build none).
+  static size_t built();
   EmbreeScene(const EmbreeScene&) = delete;
   EmbreeScene& operator=(const EmbreeScene&) = delete;
 

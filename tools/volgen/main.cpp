@@ -3,6 +3,7 @@
 //   plume-volgen fire --out volumes/fire --frames 24 --res 64
 //   plume-volgen procedural --out volumes/procedural
 //   plume-volgen sky --out volumes/sky/sky.exr
+//   plume-volgen mesh --out volumes/smoke/sphere.obj
 //   plume-volgen badinputs --out tests/bad_inputs
 //   plume-volgen preview FILE.vdb -o FILE.pgm
 #include "volgen.h"
@@ -59,6 +60,15 @@ int main(int argc, char** argv) {
   sk->add_option("--sun-radius", sky.sunRadiusDeg, "angular radius of the sun disk, degrees")->capture_default_str();
   sk->add_option("--sun-irradiance", sky.sunIrradiance, "irradiance of the sun disk")->capture_default_str();
   sk->callback([&] { action = [&] { return runSky(sky); }; });
+
+  MeshParams mesh;
+  auto* me = app.add_subcommand("mesh", "a sphere with vertex normals as a Wavefront OBJ (the bundled surface scene's object)");
+  me->add_option("--out", mesh.out, "output .obj")->capture_default_str();
+  me->add_option("--centre", mesh.centre, "world centre")->expected(3);
+  me->add_option("--radius", mesh.radius, "radius, world units")->capture_default_str();
+  me->add_option("--rings", mesh.rings, "latitude bands")->capture_default_str();
+  me->add_option("--segments", mesh.segments, "meridians")->capture_default_str();
+  me->callback([&] { action = [&] { return runMesh(mesh); }; });
 
   std::string badOut = "tests/bad_inputs";
   auto* bi = app.add_subcommand("badinputs", "broken VDB files for tests/bad_inputs");

@@ -77,6 +77,16 @@ int runSky(const SkyParams& p);
 // Writes RGB half-float texels (row-major, top row first) as a ZIP-compressed EXR.
 void writeSkyExr(const std::string& path, int width, int height, const std::vector<float>& rgb);
 
+// A sphere as a Wavefront OBJ with per-vertex normals (mesh.cpp), for the bundled surface scenes.
+struct MeshParams {
+  std::string out = "volumes/smoke/sphere.obj";
+  std::array<double, 3> centre{0.7, 0.25, -0.25};
+  double radius = 0.25;
+  int rings = 24;
+  int segments = 48;
+};
+int runMesh(const MeshParams& p);
+
 int runProcedural(const std::string& outDir);
 int runBadInputs(const std::string& outDir);
 
