@@ -160,7 +160,7 @@ TEST_F(GpuSurfaceTest, EmissiveQuadsAsTheOnlyLightsMatchReference) {
   s.surfaces.push_back(emitter({0.2f, 2.4f, 1.0f}, {0.3f, -1.0f, 0.0f}, {0.5f, 0.5f}, {12.0f, 9.0f, 6.0f}));
   s.surfaces.push_back(emitter({1.8f, 2.2f, 0.6f}, {-0.2f, -1.0f, 0.3f}, {0.3f, 0.6f}, {4.0f, 6.0f, 12.0f}));
   s.surfaces.push_back(emitter({1.0f, 0.02f, 2.6f}, {0.0f, -1.0f, 0.0f}, {0.6f, 0.6f}, {50.0f, 50.0f, 50.0f}));
-  renderAndCompare(ctx(), compiler(), s, test::makeNoiseGrid(32, 1.0 / 16, 7), 1024, 2048, "emissive_quads");
+  renderAndCompare(ctx(), compiler(), s, test::makeNoiseGrid(32, 1.0 / 16, 7), 4096, 8192, "emissive_quads");
 }
 
 // DESIGN §5: a scene without surfaces compiles no traversal (no BVH binding in its kernels) and
