@@ -20,6 +20,7 @@
 #include "shared/bvh.h"
 #include "shared/bsdf.h"
 #include "shared/pt_wave.h"
+#include "shared/surface_types.h"
 
 // restir_mis.h reads its inputs through accessor macros (here: small tables).
 float misM[3];
@@ -160,6 +161,13 @@ void main() {
   PtPush push;
   push.slots = wave.extendArgs.w;
   t += float(push.slots + wave.extendArgs.x);
+  // surface_types.h (layouts only)
+  GpuSurfaceMaterial material;
+  material.bsdf = bsdf;
+  material.emission = vec3(PT_PATH_BYTES);
+  GpuEmitterAlias alias;
+  alias.keep = material.emission.x;
+  t += alias.keep + material.bsdf.alpha;
   values[i] = vec4(s + wo, t + m + (picked ? 1.0f : 0.0f) + (dropped ? 2.0f : 0.0f) +
                    (rs_is_finite(back.W) ? back.W : 0.0f));
 }
