@@ -78,18 +78,19 @@ void expectWindowIsTheScreenshot(const std::string& dir, int width, int height) 
 
 }  // namespace
 
-TEST(View, ScriptedScreenshotIsTheSmokeAndMatchesAnOffscreenRender) {
-  if (!haveXvfbRun()) GTEST_SKIP() << "xvfb-run is not installed";
-  const std::string dir = test::outputDir("view");
+// Runs the viewer on `scene` for 8 path-traced frames and compares its screenshot with an
+// offscreen render of the same samples, and the presented window with the screenshot.
+void expectScriptedViewMatchesRender(const std::string& scene, const std::string& name) {
+  const std::string dir = test::outputDir(name);
   const std::vector<std::string> pose = {"--width", "64", "--height", "48", "--seed", "3"};
   std::string log;
-  std::vector<std::string> args = {kScene, "--frames", "8", "--screenshot", dir + "/view.png",
+  std::vector<std::string> args = {scene, "--frames", "8", "--screenshot", dir + "/view.png",
                                    "--capture-window", dir + "/window.png", "--window-scale", "1", "--hide-ui"};
   args.insert(args.end(), pose.begin(), pose.end());
   ASSERT_EQ(runView(args, log), 0) << log;
   EXPECT_EQ(log.find("validation:"), std::string::npos) << log;
 
-  std::vector<std::string> render = {"render", kScene, "--frames", "1", "--spp", "8", "-o", dir + "/render.exr", "--png"};
+  std::vector<std::string> render = {"render", scene, "--frames", "1", "--spp", "8", "-o", dir + "/render.exr", "--png"};
   render.insert(render.end(), pose.begin(), pose.end());
   test::RunResult r = test::runPlume(render);
   ASSERT_EQ(r.exitCode, 0) << r.output;
@@ -119,6 +120,17 @@ TEST(View, ScriptedScreenshotIsTheSmokeAndMatchesAnOffscreenRender) {
   EXPECT_LT(relMse, 1e-6);
 
   expectWindowIsTheScreenshot(dir, 64, 48);
+}
+
+TEST(View, ScriptedScreenshotIsTheSmokeAndMatchesAnOffscreenRender) {
+  if (!haveXvfbRun()) GTEST_SKIP() << "xvfb-run is not installed";
+  expectScriptedViewMatchesRender(kScene, "view");
+}
+
+// Surfaces with the path tracer (the bundled smoke over a ground beside a conductor sphere).
+TEST(View, SurfacesWithThePathTracerMatchAnOffscreenRender) {
+  if (!haveXvfbRun()) GTEST_SKIP() << "xvfb-run is not installed";
+  expectScriptedViewMatchesRender(test::sourcePath("volumes/smoke/smoke_ground.json"), "view_surfaces");
 }
 
 // ReSTIR in the viewer: the display pass reads ReSTIR's device accumulation in place; the

@@ -4,6 +4,8 @@
 #include "app/settings_cli.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "render/estimator.h"
+#include "render/gpu_scene.h"
 #include "viewer/viewer.h"
 
 #include <memory>
@@ -21,8 +23,10 @@ struct ViewArgs {
 int runView(ViewArgs& a) {
   setQuiet(a.options.quiet);
   Scene scene = loadScene(a.scene);
-  refuseSurfaces(scene);
   applyOverrides(scene.render, a.overrides);
+  // The path tracer renders surfaces; a mode that does not is refused here, and switching to it
+  // in the panel shows the same message and stays with the path tracer (Viewer::rebuildRenderer).
+  checkGpuSupports(scene, "--mode " + scene.render.mode, estimatorKind(scene.render) == EstimatorKind::PathTracer);
   if (a.width > 0) scene.camera.width = a.width;
   if (a.height > 0) scene.camera.height = a.height;
   if (scene.media.empty()) throw InputError(scene.path + ": media: the viewer needs a medium");
