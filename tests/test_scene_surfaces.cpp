@@ -1,8 +1,8 @@
 // DESIGN §9 surfaces[]: an OBJ or the built-in plane, an optional transform (translate /
 // rotate_deg / scale, or a 4x4 matrix), a material (diffuse albedo, or conductor with roughness
 // and f0) and an optional emission; errors name the key. The transform's composition equals
-// geometry's Transform::fromTrs. Every command refuses a scene with surfaces until an estimator
-// renders them (issue 12; the CLI side is in tests/bad_inputs/cases.json).
+// geometry's Transform::fromTrs. Which commands render surfaces: tests/bad_inputs/cases.json
+// (ReSTIR refuses them), tests/test_gpu_surfaces.cpp, tests/test_reference_surfaces.cpp.
 #include "core/error.h"
 #include "geometry/mesh.h"
 #include "geometry/scene_mesh.h"
@@ -117,17 +117,6 @@ TEST(SceneSurfaces, ErrorsNameTheKey) {
   EXPECT_EQ(e(R"([{"obj": "ground.obj", "emission": [1, -1, 1]}])"), "scene.json: surfaces[0].emission: expected 3 numbers >= 0");
   EXPECT_EQ(e(R"([{"obj": "ground.obj", "albedo": [1, 1, 2]}])"), "scene.json: surfaces[0].albedo: expected 3 numbers in [0,1]");
   EXPECT_EQ(e(R"([{"obj": "ground.obj", "colour": [1, 1, 1]}])"), "scene.json: surfaces[0].colour: unknown key");
-}
-
-TEST(SceneSurfaces, RefusedUntilRendered) {
-  const Scene none = parseScene(sceneWith(json::array()), "scene.json", sceneDir());
-  EXPECT_NO_THROW(refuseSurfaces(none));
-  try {
-    refuseSurfaces(parse(json::parse(R"([{"plane": {"size": 1}}])")));
-    FAIL() << "no error";
-  } catch (const InputError& e) {
-    EXPECT_EQ(std::string(e.what()), "scene.json: surfaces: surfaces are parsed but not yet rendered (issue 12)");
-  }
 }
 
 TEST(SceneSurfaces, LoadedIntoOneWorldSpaceMesh) {

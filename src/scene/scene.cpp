@@ -361,10 +361,6 @@ std::string expandFramePattern(const std::string& pattern, int frame) {
 bool Medium::animated() const { return hasFramePattern(vdb); }
 std::string Medium::vdbPath(int frame) const { return expandFramePattern(vdb, frame); }
 
-void refuseSurfaces(const Scene& scene) {
-  if (!scene.surfaces.empty()) throw InputError(scene.path + ": surfaces: surfaces are parsed but not yet rendered (issue 12)");
-}
-
 bool Scene::hasEnvironment() const {
   return std::any_of(lights.begin(), lights.end(), [](const Light& l) { return l.type == LightType::Environment; });
 }

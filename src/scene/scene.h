@@ -129,10 +129,6 @@ struct Scene {
   Medium& medium() { return media.at(0); }
 };
 
-// Surfaces are parsed and validated but no estimator renders them yet (issue 12): every command
-// that renders calls this first. Throws InputError "<file>: surfaces: surfaces are parsed but not
-// yet rendered (issue 12)" when the scene has any.
-void refuseSurfaces(const Scene& scene);
 
 // Reads and validates a scene file. Throws InputError.
 Scene loadScene(const std::string& path);
