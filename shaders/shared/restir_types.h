@@ -25,6 +25,11 @@ PLUME_NS_BEGIN
 
 const uint RS_MAX_VERTICES = 16u;  // longest path a reservoir stores (render.restir_prefix <= this)
 const uint RS_MAX_NEIGHBOURS = 8u;
+// Final shading's tail (restir/shade.glsl) walks at most this many segments, each with a light
+// ray, per dispatch of passes/restir_tail.comp: a bounded share of lavapipe's loop budget
+// (docs/architecture.md) whatever max_bounces is.
+const uint RS_TAIL_SEGMENTS = 8u;
+const uint RS_TAIL_STATE_SLOTS = 5u;  // vec4s of a pixel's tail state (restir/shade.glsl RsTail)
 const uint RS_LIGHT_EMISSION = 0xFFFFFFFFu;  // RsPathHead.light of a path ending in emission
 
 const uint RS_MIS_PAIRWISE = 0u;  // pairwise MIS with confidence weights (default, O(k))

@@ -21,6 +21,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace plume {
 
@@ -74,6 +75,7 @@ class Restir {
 
  private:
   void fillFrame(int frame, uint32_t sequence, uint32_t key);
+  std::vector<gpu::ComputePass*> passes() const;
 
   gpu::Context& ctx_;
   const Scene& scene_;
@@ -81,6 +83,8 @@ class Restir {
   FeatureSet features_;
   std::unique_ptr<GpuEnvironmentMap> envMap_;
   std::unique_ptr<gpu::ComputePass> candidates_, temporal_, spatial_, shade_;
+  std::unique_ptr<gpu::ComputePass> tail_;  // final shading's tail (null without one)
+  uint32_t tailDispatches_ = 0;             // its dispatches per frame
   gpu::GpuTimer timer_;
   gpu::Buffer frameBuffer_, lightBuffer_, lightChoice_, paramBuffer_, reservoirs_, paths_, bounces_, output_, counters_;
   shared::GpuFrame frame_{};
