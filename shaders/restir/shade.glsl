@@ -40,19 +40,16 @@ struct RsTail {
   vec3 shaded;  // final shading's other terms (rs_shade): the pixel's sample is shaded + L
 };
 
-// The walk's state, [2 * pixels + 5 * pixel + i], past the accumulation (restir.cpp sizes the
-// buffer: RS_TAIL_STATE_SLOTS).
-uint rs_tail_slot(uint pixelIndex) { return 2u * rsp.pixelCount + RS_TAIL_STATE_SLOTS * pixelIndex; }
-
+// The walk's state: rsOutput[rs_state_slot(pixel) + i], i < RS_STATE_SLOTS.
 RsTail rs_tail_load(uint pixelIndex) {
-  uint s = rs_tail_slot(pixelIndex);
+  uint s = rs_state_slot(pixelIndex);
   vec4 a = rsOutput[s], b = rsOutput[s + 1u];
   return RsTail(a.xyz, floatBitsToUint(a.w), b.xyz, floatBitsToUint(b.w), rsOutput[s + 2u].xyz,
                 rsOutput[s + 3u].xyz, rsOutput[s + 4u].xyz);
 }
 
 void rs_tail_store(uint pixelIndex, RsTail s) {
-  uint i = rs_tail_slot(pixelIndex);
+  uint i = rs_state_slot(pixelIndex);
   rsOutput[i] = vec4(s.x, uintBitsToFloat(s.j));
   rsOutput[i + 1u] = vec4(s.w, uintBitsToFloat(s.rngCounter));
   rsOutput[i + 2u] = vec4(s.beta, 0.0f);

@@ -154,9 +154,9 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   reservoirs_ = gpu::Buffer(ctx, kSets * pixels * sizeof(shared::RsPacked), storage, "reservoirs");
   paths_ = gpu::Buffer(ctx, kSets * pixels * sizeof(shared::RsPathHead), storage, "reservoir paths");
   bounces_ = gpu::Buffer(ctx, kSets * pixels * stride * sizeof(glm::vec4), storage, "reservoir path vertices");
-  // The accumulation, then (with a tail) each pixel's unfinished tail walk (restir/shade.glsl).
-  output_ = gpu::Buffer(ctx, (2 + (tail ? shared::RS_TAIL_STATE_SLOTS : 0)) * pixels * sizeof(glm::vec4), storage,
-                        "restir accumulation");
+  // The accumulation, then each pixel's state between the dispatches of a pass (the candidates'
+  // running reservoir, the tail's walk: restir/bridge.glsl rs_state_slot).
+  output_ = gpu::Buffer(ctx, (2 + shared::RS_STATE_SLOTS) * pixels * sizeof(glm::vec4), storage, "restir accumulation");
   counters_ = gpu::Buffer(ctx, 16, storage, "restir counters");
   counters_.fillZero();
   reservoirs_.fillZero();
@@ -249,7 +249,14 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
     uint32_t cur = (hist + 1) % kSets;
     shared::RsPush push{};
     push.outSet = cur;
-    candidates_->record(cmd, items, &push, &timer_);
+    // One dispatch per candidate walk (lavapipe's loop budget: restir/candidates.glsl).
+    const uint32_t candidates = timer_.begin(cmd, "restir candidates");
+    for (int m = 0; m < options_.candidates; ++m) {
+      if (m > 0) gpu::computeBarrier(cmd);
+      push.candidate = uint32_t(m);
+      candidates_->record(cmd, items, &push);
+    }
+    timer_.end(cmd, candidates);
     labels.push_back("candidates");
     gpu::computeBarrier(cmd);
     if (temporal) {
