@@ -14,16 +14,18 @@
 // to vertex max_bounces + 1: both ends go through the one reservoir, so reuse shares good
 // emitters too. Emission seen directly (a one-vertex path) is final shading's, by tracking along
 // the camera ray (restir/shade.glsl): every path is counted once.
-// The reservoir's confidence is M. One dispatch per walk (lavapipe's loop budget,
-// docs/architecture.md: an invocation walks at most K vertices, whatever M): walk m streams its
+// The reservoir's confidence is M. A dispatch walks rsp.walksPerDispatch of the M walks
+// (lavapipe's loop budget, docs/architecture.md: an invocation walks at most
+// RS_CANDIDATE_VERTICES vertices, or one walk of K, whatever M): the walks stream their
 // candidates into the pixel's running reservoir, kept between dispatches (w_sum, p̂ and the
 // candidates' random stream in the pixel's state slot, the selected path in the output set), and
-// the last walk finalises it: the same draws in the same order as M walks in one invocation.
-// Requires restir/bridge.glsl.
+// the dispatch of the last walk finalises it: the same draws in the same order as M walks in one
+// invocation. Requires restir/bridge.glsl.
 #ifndef PLUME_RESTIR_CANDIDATES_GLSL
 #define PLUME_RESTIR_CANDIDATES_GLSL
 
-void rs_candidate_walk(uvec2 pixel, uint pixelIndex, uint outSet, uint m) {
+// Walks first .. first + rsp.walksPerDispatch - 1 (at most M - 1) of the pixel's M.
+void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
   RsDomain D = rs_current_domain(pixel);
   RngState rng = rng_init(pixel, frame.frameKey, RNG_STREAM_CANDIDATES, frame.seed);
   uint M = rsp.candidates;
@@ -40,7 +42,7 @@ void rs_candidate_walk(uvec2 pixel, uint pixelIndex, uint outSet, uint m) {
   uint base = rs_bounce_base(outSet, pixelIndex);
   RsReservoir r = rs_empty();
   RsPathHead head;
-  if (m == 0u) {
+  if (first == 0u) {
     head.lightSample = vec2(0.0f);
     head.t1 = 0.0f;
     head.vertexCount = 0u;
@@ -56,73 +58,76 @@ void rs_candidate_walk(uvec2 pixel, uint pixelIndex, uint outSet, uint m) {
     head = rs_load_head(outSet, pixelIndex);
   }
   vec4 walk[RS_MAX_VERTICES - 1u];
-  uint uv = rs_pack_uv(rng_float2(rng));  // the sub-pixel position: pdf 1 on the pixel
-  vec3 x = D.origin;
-  vec3 w = rs_domain_dir(D, rs_unpack_uv(uv));
-  vec3 f = vec3(1.0f);  // prefix of f_D with coarse transmittance (the target's)
-  float pdf = 1.0f;     // prefix of the source pdf
-  float t1 = 0.0f;
-  uint keep = 0u;  // vertices of this walk's selected candidate (0: none): copied when the walk ends
-  for (uint j = 1u; j <= walkVertices; ++j) {
-    float t;
-    float sigmaC;
-    float tau;
-    if (!vol_mean_sample(x, w, DDA_INF, rng_float(rng), t, sigmaC, tau)) break;
-    float trTarget = exp(-min(tau, VOL_MAX_TAU));  // the target's transmittance (same field)
-    x += t * w;
-    float sigma = vol_sigma_t_world(VOL_CURRENT, x);
-    if (!(sigma > 0.0f)) break;  // f = 0 for this path and every extension of it
-    pdf *= sigmaC * exp(-tau);   // the sampling field's free-flight pdf
-    vec3 fArrive = f * trTarget * sigma;  // before x_j scatters or absorbs
-    f = fArrive * vtx_albedo(VERTEX_MEDIUM);
-    if (j == 1u) {
-      t1 = t;
-    } else {
-      walk[j - 2u] = vec4(w, t);
-    }
-#ifdef PLUME_HAS_EMISSION
-    if (j >= 2u) {  // the candidate ending with x_j's emission: sigma_a Le instead of scattering
-      float ph = rs_luminance(fArrive * (vec3(1.0f) - vtx_albedo(VERTEX_MEDIUM)) * vol_emitted_radiance_world(VOL_CURRENT, x));
-      if (rs_update(r, invM * ph / pdf, ph, 0.0f, rng_float(rng))) {
-        head.lightSample = vec2(0.0f);
-        head.t1 = t1;
-        head.vertexCount = j;
-        head.light = RS_LIGHT_EMISSION;
-        head.uv = uv;
-        keep = j;
+  uint last = min(first + rsp.walksPerDispatch, M);
+  for (uint m = first; m < last; ++m) {
+    uint uv = rs_pack_uv(rng_float2(rng));  // the sub-pixel position: pdf 1 on the pixel
+    vec3 x = D.origin;
+    vec3 w = rs_domain_dir(D, rs_unpack_uv(uv));
+    vec3 f = vec3(1.0f);  // prefix of f_D with coarse transmittance (the target's)
+    float pdf = 1.0f;     // prefix of the source pdf
+    float t1 = 0.0f;
+    uint keep = 0u;  // vertices of this walk's selected candidate (0: none): copied when the walk ends
+    for (uint j = 1u; j <= walkVertices; ++j) {
+      float t;
+      float sigmaC;
+      float tau;
+      if (!vol_mean_sample(x, w, DDA_INF, rng_float(rng), t, sigmaC, tau)) break;
+      float trTarget = exp(-min(tau, VOL_MAX_TAU));  // the target's transmittance (same field)
+      x += t * w;
+      float sigma = vol_sigma_t_world(VOL_CURRENT, x);
+      if (!(sigma > 0.0f)) break;  // f = 0 for this path and every extension of it
+      pdf *= sigmaC * exp(-tau);   // the sampling field's free-flight pdf
+      vec3 fArrive = f * trTarget * sigma;  // before x_j scatters or absorbs
+      f = fArrive * vtx_albedo(VERTEX_MEDIUM);
+      if (j == 1u) {
+        t1 = t;
+      } else {
+        walk[j - 2u] = vec4(w, t);
       }
-    }
-    if (j > maxVertices) break;  // no scattering beyond max_bounces
-#endif
-    uvec4 h = rng_next4(rng);
-    uint light;
-    vec2 ls;
-    float pl = rs_sample_light(w, vec3(rng_to_float(h.x), rng_to_float(h.y), rng_to_float(h.z)), light, ls);
-    if (pl > 0.0f) {
-      float ph = rs_luminance(f * rs_light_term(VOL_CURRENT, VERTEX_MEDIUM, light, ls, x, w, false, rng));
-      float weight = invM * ph / (pdf * pl);
-      if (rs_update(r, weight, ph, 0.0f, rng_to_float(h.w))) {
-        head.lightSample = ls;
-        head.t1 = t1;
-        head.vertexCount = j;
-        head.light = light;
-        head.uv = uv;
-        keep = j;
+  #ifdef PLUME_HAS_EMISSION
+      if (j >= 2u) {  // the candidate ending with x_j's emission: sigma_a Le instead of scattering
+        float ph = rs_luminance(fArrive * (vec3(1.0f) - vtx_albedo(VERTEX_MEDIUM)) * vol_emitted_radiance_world(VOL_CURRENT, x));
+        if (rs_update(r, invM * ph / pdf, ph, 0.0f, rng_float(rng))) {
+          head.lightSample = vec2(0.0f);
+          head.t1 = t1;
+          head.vertexCount = j;
+          head.light = RS_LIGHT_EMISSION;
+          head.uv = uv;
+          keep = j;
+        }
       }
+      if (j > maxVertices) break;  // no scattering beyond max_bounces
+  #endif
+      uvec4 h = rng_next4(rng);
+      uint light;
+      vec2 ls;
+      float pl = rs_sample_light(w, vec3(rng_to_float(h.x), rng_to_float(h.y), rng_to_float(h.z)), light, ls);
+      if (pl > 0.0f) {
+        float ph = rs_luminance(f * rs_light_term(VOL_CURRENT, VERTEX_MEDIUM, light, ls, x, w, false, rng));
+        float weight = invM * ph / (pdf * pl);
+        if (rs_update(r, weight, ph, 0.0f, rng_to_float(h.w))) {
+          head.lightSample = ls;
+          head.t1 = t1;
+          head.vertexCount = j;
+          head.light = light;
+          head.uv = uv;
+          keep = j;
+        }
+      }
+      if (j == walkVertices) break;
+      if (j >= frame.rrStartBounce) {  // Russian roulette with a fixed probability: part of the pdf
+        if (rng_float(rng) >= q) break;
+        pdf *= q;
+      }
+      vec3 wNext = vtx_sample(VERTEX_MEDIUM, w, rng_float2(rng));
+      float phase = vtx_scatter(VERTEX_MEDIUM, w, wNext);
+      pdf *= phase;
+      f *= phase;
+      w = wNext;
     }
-    if (j == walkVertices) break;
-    if (j >= frame.rrStartBounce) {  // Russian roulette with a fixed probability: part of the pdf
-      if (rng_float(rng) >= q) break;
-      pdf *= q;
-    }
-    vec3 wNext = vtx_sample(VERTEX_MEDIUM, w, rng_float2(rng));
-    float phase = vtx_scatter(VERTEX_MEDIUM, w, wNext);
-    pdf *= phase;
-    f *= phase;
-    w = wNext;
+    for (uint i = 0u; i + 2u <= keep; ++i) rsBounces[base + i] = walk[i];
   }
-  for (uint i = 0u; i + 2u <= keep; ++i) rsBounces[base + i] = walk[i];
-  if (m + 1u < M) {
+  if (last < M) {
     rsOutput[rs_state_slot(pixelIndex)] = vec4(r.w_sum, r.p_hat, uintBitsToFloat(rng.counter), 0.0f);
     rs_store_head(outSet, pixelIndex, head);
     return;

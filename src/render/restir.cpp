@@ -176,6 +176,7 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   params_.candidates = uint32_t(options_.candidates);
   params_.bounceStride = stride;
   params_.prefixVertices = uint32_t(prefix);
+  params_.walksPerDispatch = std::max(1u, shared::RS_CANDIDATE_VERTICES / uint32_t(features_.emission ? emitting : prefix));
   params_.pixelCount = uint32_t(pixels);
   params_.lightCount = uint32_t(scene.lights.size());
   params_.historyCap = float(options_.historyCap);
@@ -249,11 +250,11 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
     uint32_t cur = (hist + 1) % kSets;
     shared::RsPush push{};
     push.outSet = cur;
-    // One dispatch per candidate walk (lavapipe's loop budget: restir/candidates.glsl).
+    // walksPerDispatch candidate walks per dispatch (lavapipe's loop budget: restir/candidates.glsl).
     const uint32_t candidates = timer_.begin(cmd, "restir candidates");
-    for (int m = 0; m < options_.candidates; ++m) {
+    for (uint32_t m = 0; m < params_.candidates; m += params_.walksPerDispatch) {
       if (m > 0) gpu::computeBarrier(cmd);
-      push.candidate = uint32_t(m);
+      push.candidate = m;
       candidates_->record(cmd, items, &push);
     }
     timer_.end(cmd, candidates);
