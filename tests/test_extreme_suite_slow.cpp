@@ -80,6 +80,25 @@ TEST_F(ExtremeSuiteSlow, DenseAndBright256BouncesMatchesReference) {
   }
 }
 
+// ReSTIR's part of ExtremeSuite.DenseAndBright (the same size, reference and runs; notes/extreme.md,
+// finding 1): 3056 of its invocations spent lavapipe's loop budget on the 256-bounce tail of
+// final shading (mean ratio 0.978, aggregate z -1.3..-1.6, counted as truncations) until the
+// tail walked at most RS_TAIL_SEGMENTS segments per dispatch and the candidates one walk per
+// dispatch; none is cut since.
+TEST_F(ExtremeSuiteSlow, DenseAndBrightRestir) {
+  for (const test::ExtremeCase& c : test::extremeCases({8, 256})) {
+    if (c.name != "dense_bright") continue;
+    const test::EstimatorRun ref = test::runReferenceCase(c, 256);
+    const test::EstimatorRun rs = test::runRestirCase(ctx(), compiler(), c, 256, shared::RS_MIS_PAIRWISE);
+    EXPECT_EQ(ref.truncated + rs.truncated + ref.nonFinite + rs.nonFinite, 0u);
+    test::ReferenceCheckOptions options;
+    options.outputGroup = "extreme_suite";
+    options.imageMeanVariance = rs.imageMeanVariance;
+    test::expectMatchesReference(rs.image, ref.image, "dense_bright_restir", options);
+    std::printf("[extreme] dense_bright restir: %.2f s\n", rs.seconds);
+  }
+}
+
 // The bounded-time case: the values grid at 64², 16 samples per pixel, every estimator
 // (seconds, not minutes; no tracking loop truncated).
 TEST_F(ExtremeSuiteSlow, ValuesGridAt64x64With16SppIsFast) {

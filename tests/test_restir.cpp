@@ -90,6 +90,9 @@ struct RestirRun {
   Image mean;
   glm::dvec3 imageMeanVariance{0.0};  // see test::RunAccumulator
   uint32_t dropped = 0;
+  // Tracking loops cut by the step cap or by the driver's loop budget (volume/loop_guard.glsl),
+  // as support/extreme.cpp counts them: any is a truncated, biased image.
+  uint32_t truncated = 0;
   double seconds = 0;
 };
 
@@ -122,6 +125,7 @@ RestirRun runRestir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scen
     }
     acc.add(last);
   }
+  for (const auto& v : volumes) out.truncated += v->truncatedCount() + v->loopLimitCount();
   out.mean = acc.image(scene.camera.width, scene.camera.height);
   out.imageMeanVariance = acc.imageMeanVariance();
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -155,6 +159,7 @@ void expectMatches(const RestirRun& run, const Image& ref, const std::string& na
   SCOPED_TRACE(overrides().empty() ? "default run counts and seeds" : "NON-DEFAULT: " + overrides());
   test::expectMatchesReference(run.mean, ref, name, checkOptions(run));
   EXPECT_EQ(run.dropped, 0u) << name;
+  EXPECT_EQ(run.truncated, 0u) << name;
   std::printf("[restir] %s: %.1f s\n", name.c_str(), run.seconds);
 }
 
@@ -302,6 +307,7 @@ TEST_F(GpuRestir, BiasedModeReportsBoundedBias) {
   }
   EXPECT_LT(check.pixels.relMse, 0.05);
   EXPECT_EQ(run.dropped, 0u);
+  EXPECT_EQ(run.truncated, 0u);
 }
 
 // --- Environment maps (DESIGN §2): the map's light samples are directions drawn from its texels'
@@ -417,4 +423,5 @@ TEST_F(GpuRestir, AcceptsAnyMaxBouncesWithFixedMemory) {
   RestirRun run = runRestir(ctx(), compiler(), s, o, spec, [&](int) { return grid; });
   for (float v : run.mean.rgb) EXPECT_TRUE(std::isfinite(v));
   EXPECT_EQ(run.dropped, 0u);
+  EXPECT_EQ(run.truncated, 0u);
 }

@@ -1,4 +1,6 @@
-// ReSTIR pass 1 (DESIGN §4.2 step 1): M candidate paths per pixel into reservoir set push.outSet.
+// ReSTIR pass 1 (DESIGN §4.2 step 1): candidate walks push.candidate .. of the M per pixel into
+// reservoir set push.outSet, rsp.walksPerDispatch of them; the host dispatches it until all M are
+// walked (restir/candidates.glsl).
 #version 450
 #extension GL_GOOGLE_include_directive : require
 
@@ -12,6 +14,6 @@ layout(local_size_x = 8, local_size_y = 8) in;
 void main() {
   uvec2 pixel = gl_GlobalInvocationID.xy;
   if (pixel.x >= frame.size.x || pixel.y >= frame.size.y) return;
-  rs_generate_candidates(pixel, pixel.y * frame.size.x + pixel.x, push.outSet);
+  rs_candidate_walks(pixel, pixel.y * frame.size.x + pixel.x, push.outSet, push.candidate);
   loop_guard_check(frame.loopProbe);
 }

@@ -22,7 +22,8 @@ layout(std430, binding = BIND_RS_RESERVOIRS) buffer ReservoirBuffer { RsPacked r
 layout(std430, binding = BIND_RS_PATHS) buffer PathBuffer { uvec4 rsPathWords[]; };
 // Vertices 2..n of each stored path: [(set * pixels + pixel) * stride + i - 2] = (w_i, t_i).
 layout(std430, binding = BIND_RS_BOUNCES) buffer BounceBuffer { vec4 rsBounces[]; };
-// Progressive accumulation of final shading: [2 * pixel] = (mean rgb, n), [2 * pixel + 1] = (M2 rgb, 0).
+// Progressive accumulation of final shading: [2 * pixel] = (mean rgb, n), [2 * pixel + 1] = (M2 rgb, 0);
+// then RS_STATE_SLOTS per pixel of the passes' state between dispatches (bridge.glsl rs_state_slot).
 layout(std430, binding = BIND_RS_OUTPUT) buffer OutputBuffer { vec4 rsOutput[]; };
 // rsCounters[0]: reservoirs whose non-finite weights were dropped on unpack (this frame).
 layout(std430, binding = BIND_RS_COUNTERS) buffer RestirCounterBuffer { uint rsCounters[]; };

@@ -126,6 +126,11 @@ void rs_store_head(uint set, uint pixelIndex, RsPathHead h) {
   rsPathWords[i + 1u] = uvec4(h.light, h.kinds, h.uv, h.pad0);
 }
 
+// A pixel's state between the dispatches of one pass (RS_STATE_SLOTS vec4s past the
+// accumulation): the candidates' running reservoir (restir/candidates.glsl), then final
+// shading's tail (restir/shade.glsl).
+uint rs_state_slot(uint pixelIndex) { return 2u * rsp.pixelCount + RS_STATE_SLOTS * pixelIndex; }
+
 // Vertex count of the stored path (0: none), and marking a slot empty.
 uint rs_path_length(uint set, uint pixelIndex) { return rsPathWords[2u * rs_slot(set, pixelIndex)].w; }
 void rs_clear_path(uint set, uint pixelIndex) { rsPathWords[2u * rs_slot(set, pixelIndex)].w = 0u; }

@@ -14,11 +14,18 @@
 // to vertex max_bounces + 1: both ends go through the one reservoir, so reuse shares good
 // emitters too. Emission seen directly (a one-vertex path) is final shading's, by tracking along
 // the camera ray (restir/shade.glsl): every path is counted once.
-// The reservoir's confidence is M. Requires restir/bridge.glsl.
+// The reservoir's confidence is M. A dispatch walks rsp.walksPerDispatch of the M walks
+// (lavapipe's loop budget, docs/architecture.md: an invocation walks at most
+// RS_CANDIDATE_VERTICES vertices, or one walk of K, whatever M): the walks stream their
+// candidates into the pixel's running reservoir, kept between dispatches (w_sum, p̂ and the
+// candidates' random stream in the pixel's state slot, the selected path in the output set), and
+// the dispatch of the last walk finalises it: the same draws in the same order as M walks in one
+// invocation. Requires restir/bridge.glsl.
 #ifndef PLUME_RESTIR_CANDIDATES_GLSL
 #define PLUME_RESTIR_CANDIDATES_GLSL
 
-void rs_generate_candidates(uvec2 pixel, uint pixelIndex, uint outSet) {
+// Walks first .. first + rsp.walksPerDispatch - 1 (at most M - 1) of the pixel's M.
+void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
   RsDomain D = rs_current_domain(pixel);
   RngState rng = rng_init(pixel, frame.frameKey, RNG_STREAM_CANDIDATES, frame.seed);
   uint M = rsp.candidates;
@@ -35,15 +42,24 @@ void rs_generate_candidates(uvec2 pixel, uint pixelIndex, uint outSet) {
   uint base = rs_bounce_base(outSet, pixelIndex);
   RsReservoir r = rs_empty();
   RsPathHead head;
-  head.lightSample = vec2(0.0f);
-  head.t1 = 0.0f;
-  head.vertexCount = 0u;
-  head.light = 0u;
-  head.kinds = 0u;
-  head.uv = 0u;
-  head.pad0 = 0u;
+  if (first == 0u) {
+    head.lightSample = vec2(0.0f);
+    head.t1 = 0.0f;
+    head.vertexCount = 0u;
+    head.light = 0u;
+    head.kinds = 0u;
+    head.uv = 0u;
+    head.pad0 = 0u;
+  } else {  // the walks before this one
+    vec4 state = rsOutput[rs_state_slot(pixelIndex)];
+    r.w_sum = state.x;
+    r.p_hat = state.y;
+    rng.counter = floatBitsToUint(state.z);
+    head = rs_load_head(outSet, pixelIndex);
+  }
   vec4 walk[RS_MAX_VERTICES - 1u];
-  for (uint m = 0u; m < M; ++m) {
+  uint last = min(first + rsp.walksPerDispatch, M);
+  for (uint m = first; m < last; ++m) {
     uint uv = rs_pack_uv(rng_float2(rng));  // the sub-pixel position: pdf 1 on the pixel
     vec3 x = D.origin;
     vec3 w = rs_domain_dir(D, rs_unpack_uv(uv));
@@ -68,7 +84,7 @@ void rs_generate_candidates(uvec2 pixel, uint pixelIndex, uint outSet) {
       } else {
         walk[j - 2u] = vec4(w, t);
       }
-#ifdef PLUME_HAS_EMISSION
+  #ifdef PLUME_HAS_EMISSION
       if (j >= 2u) {  // the candidate ending with x_j's emission: sigma_a Le instead of scattering
         float ph = rs_luminance(fArrive * (vec3(1.0f) - vtx_albedo(VERTEX_MEDIUM)) * vol_emitted_radiance_world(VOL_CURRENT, x));
         if (rs_update(r, invM * ph / pdf, ph, 0.0f, rng_float(rng))) {
@@ -81,7 +97,7 @@ void rs_generate_candidates(uvec2 pixel, uint pixelIndex, uint outSet) {
         }
       }
       if (j > maxVertices) break;  // no scattering beyond max_bounces
-#endif
+  #endif
       uvec4 h = rng_next4(rng);
       uint light;
       vec2 ls;
@@ -110,6 +126,11 @@ void rs_generate_candidates(uvec2 pixel, uint pixelIndex, uint outSet) {
       w = wNext;
     }
     for (uint i = 0u; i + 2u <= keep; ++i) rsBounces[base + i] = walk[i];
+  }
+  if (last < M) {
+    rsOutput[rs_state_slot(pixelIndex)] = vec4(r.w_sum, r.p_hat, uintBitsToFloat(rng.counter), 0.0f);
+    rs_store_head(outSet, pixelIndex, head);
+    return;
   }
   r.M = float(M);
   rs_finalize(r);

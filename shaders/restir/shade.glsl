@@ -21,51 +21,97 @@
 // medium the walk also gathers the emission along segment j (paths of j vertices, the last one
 // emitting) for j > rs_emission_vertices(), the longest emitting path a reservoir holds, up to
 // the segment after vertex max_bounces, as the path tracer does.
-vec3 rs_tail(RsDomain D, inout RngState rng) {
-  vec3 x = D.origin;
+//
+// The walk is resumable (lavapipe's loop budget, docs/architecture.md): final shading starts it
+// (rs_tail_start) and each dispatch of passes/restir_tail.comp advances it by at most
+// RS_TAIL_SEGMENTS segments (shared/restir_types.h; rs_tail_advance), its state in the pixel's
+// slots past the accumulation (rs_tail_load / rs_tail_store), until it ends and the pixel's
+// sample, the terms of final shading plus the tail, is accumulated. The random stream is the
+// shading stream, continued across dispatches: the same draws in the same order as one walk in
+// one invocation.
+
+struct RsTail {
+  vec3 x;
+  uint j;  // the next segment (1 = the camera ray's); 0: the walk has ended
+  vec3 w;
+  uint rngCounter;  // the shading stream's draws so far
+  vec3 beta;
+  vec3 L;       // the tail's radiance so far
+  vec3 shaded;  // final shading's other terms (rs_shade): the pixel's sample is shaded + L
+};
+
+// The walk's state: rsOutput[rs_state_slot(pixel) + i], i < RS_STATE_SLOTS.
+RsTail rs_tail_load(uint pixelIndex) {
+  uint s = rs_state_slot(pixelIndex);
+  vec4 a = rsOutput[s], b = rsOutput[s + 1u];
+  return RsTail(a.xyz, floatBitsToUint(a.w), b.xyz, floatBitsToUint(b.w), rsOutput[s + 2u].xyz,
+                rsOutput[s + 3u].xyz, rsOutput[s + 4u].xyz);
+}
+
+void rs_tail_store(uint pixelIndex, RsTail s) {
+  uint i = rs_state_slot(pixelIndex);
+  rsOutput[i] = vec4(s.x, uintBitsToFloat(s.j));
+  rsOutput[i + 1u] = vec4(s.w, uintBitsToFloat(s.rngCounter));
+  rsOutput[i + 2u] = vec4(s.beta, 0.0f);
+  rsOutput[i + 3u] = vec4(s.L, 0.0f);
+  rsOutput[i + 4u] = vec4(s.shaded, 0.0f);
+}
+
+RsTail rs_tail_start(RsDomain D, vec3 shaded, inout RngState rng) {
   vec3 w = rs_domain_dir(D, rng_float2(rng));  // its own sub-pixel position: pdf 1 on the pixel
-  vec3 beta = vec3(1.0f);
-  vec3 L = vec3(0.0f);
-  float q = min(1.0f, plume_max3(vtx_albedo(VERTEX_MEDIUM)));
+  return RsTail(D.origin, 1u, w, rng.counter, vec3(1.0f), vec3(0.0f), shaded);
+}
+
+// Segment s.j of the walk and what its vertex adds; false when the walk ends there.
+bool rs_tail_segment(inout RsTail s, inout RngState rng) {
+  uint j = s.j;
 #ifdef PLUME_HAS_EMISSION
   uint emitting = rs_emission_vertices();
   uint segments = frame.maxBounces + 1u;
+  float t;
+  vec3 emitted;
+  bool collided = vol_sample_collision_emitting(s.x, s.w, DDA_INF, rng, t, emitted);
+  if (j > emitting) s.L += s.beta * (vec3(1.0f) - vtx_albedo(VERTEX_MEDIUM)) * emitted;
+  if (!collided || j > frame.maxBounces) return false;
 #else
   uint segments = frame.maxBounces;
+  float t;
+  if (!vol_sample_collision(s.x, s.w, DDA_INF, rng, t)) return false;
 #endif
-  for (uint j = 1u; j <= segments; ++j) {
-    float t;
-#ifdef PLUME_HAS_EMISSION
-    vec3 emitted;
-    bool collided = vol_sample_collision_emitting(x, w, DDA_INF, rng, t, emitted);
-    if (j > emitting) L += beta * (vec3(1.0f) - vtx_albedo(VERTEX_MEDIUM)) * emitted;
-    if (!collided || j > frame.maxBounces) break;
-#else
-    if (!vol_sample_collision(x, w, DDA_INF, rng, t)) break;
-#endif
-    x += t * w;
-    beta *= vtx_albedo(VERTEX_MEDIUM);
-    if (j > rsp.prefixVertices) {
-      uvec4 h = rng_next4(rng);
-      uint light;
-      vec2 ls;
-      float pl = rs_sample_light(w, vec3(rng_to_float(h.x), rng_to_float(h.y), rng_to_float(h.z)), light, ls);
-      if (pl > 0.0f) L += beta * rs_light_term(VOL_CURRENT, VERTEX_MEDIUM, light, ls, x, w, true, rng) / pl;
-    }
-    if (j == segments) break;
-    if (j >= frame.rrStartBounce) {
-      if (rng_float(rng) >= q) break;
-      beta /= q;
-    }
-    w = vtx_sample(VERTEX_MEDIUM, w, rng_float2(rng));
+  s.x += t * s.w;
+  s.beta *= vtx_albedo(VERTEX_MEDIUM);
+  if (j > rsp.prefixVertices) {
+    uvec4 h = rng_next4(rng);
+    uint light;
+    vec2 ls;
+    float pl = rs_sample_light(s.w, vec3(rng_to_float(h.x), rng_to_float(h.y), rng_to_float(h.z)), light, ls);
+    if (pl > 0.0f) s.L += s.beta * rs_light_term(VOL_CURRENT, VERTEX_MEDIUM, light, ls, s.x, s.w, true, rng) / pl;
   }
-  return L;
+  if (j == segments) return false;
+  if (j >= frame.rrStartBounce) {
+    float q = min(1.0f, plume_max3(vtx_albedo(VERTEX_MEDIUM)));
+    if (rng_float(rng) >= q) return false;
+    s.beta /= q;
+  }
+  s.w = vtx_sample(VERTEX_MEDIUM, s.w, rng_float2(rng));
+  s.j = j + 1u;
+  return true;
+}
+
+// At most RS_TAIL_SEGMENTS segments of the walk; true when it has ended.
+bool rs_tail_advance(inout RsTail s, inout RngState rng) {
+  for (uint n = 0u; n < RS_TAIL_SEGMENTS; ++n) {
+    if (!rs_tail_segment(s, rng)) {
+      s.j = 0u;
+      return true;
+    }
+  }
+  return false;
 }
 #endif
 
-vec3 rs_shade(uvec2 pixel, uint pixelIndex, uint set) {
-  RsDomain D = rs_current_domain(pixel);
-  RngState rng = rng_init(pixel, frame.frameKey, RNG_STREAM_SHADING, frame.seed);
+// Final shading's terms but the tail, drawn from `rng` (the pixel's shading stream).
+vec3 rs_shade(RsDomain D, uint pixelIndex, uint set, inout RngState rng) {
   RsReservoir r = rs_load(set, pixelIndex);
   vec3 L = vec3(0.0f);
   if (r.W > 0.0f) L += r.W * rs_path_contribution(D, set, pixelIndex, true, rng);
@@ -80,17 +126,11 @@ vec3 rs_shade(uvec2 pixel, uint pixelIndex, uint set) {
   // reservoirs carry the light the fire and the lights scatter.
   L += (vec3(1.0f) - vtx_albedo(VERTEX_MEDIUM)) * vol_emission_along(D.origin, rs_domain_dir(D, rng_float2(rng)), DDA_INF, rng);
 #endif
-#ifdef PLUME_RS_TAIL
-  L += rs_tail(D, rng);
-#endif
   return L;
 }
 
-// Final shading of `pixel` from reservoir set `set`, into the accumulation (restart: the first
-// sample of a new accumulation).
-void rs_shade_pixel(uvec2 pixel, uint set, bool restart) {
-  uint index = pixel.y * frame.size.x + pixel.x;
-  vec3 L = rs_shade(pixel, index, set);
+// The pixel's sample L into the accumulation (restart: the first sample of a new accumulation).
+void rs_accumulate(uint index, vec3 L, bool restart) {
   if (restart) {
     rsOutput[2u * index] = vec4(L, 1.0f);
     rsOutput[2u * index + 1u] = vec4(0.0f);
@@ -102,5 +142,37 @@ void rs_shade_pixel(uvec2 pixel, uint set, bool restart) {
   rsOutput[2u * index] = a;
   rsOutput[2u * index + 1u] = vec4(m2, 0.0f);
 }
+
+RngState rs_shading_rng(uvec2 pixel) { return rng_init(pixel, frame.frameKey, RNG_STREAM_SHADING, frame.seed); }
+
+// Final shading of `pixel` from reservoir set `set`, into the accumulation; with a tail, the
+// tail's walk is started instead and the sample is accumulated when it ends (rs_tail_pixel).
+void rs_shade_pixel(uvec2 pixel, uint set, bool restart) {
+  uint index = pixel.y * frame.size.x + pixel.x;
+  RsDomain D = rs_current_domain(pixel);
+  RngState rng = rs_shading_rng(pixel);
+  vec3 L = rs_shade(D, index, set, rng);
+#ifdef PLUME_RS_TAIL
+  rs_tail_store(index, rs_tail_start(D, L, rng));
+#else
+  rs_accumulate(index, L, restart);
+#endif
+}
+
+#ifdef PLUME_RS_TAIL
+// One dispatch of the tail's walk of `pixel` (passes/restir_tail.comp); the sample is accumulated
+// once the walk has ended.
+void rs_tail_pixel(uvec2 pixel, bool restart) {
+  uint index = pixel.y * frame.size.x + pixel.x;
+  RsTail s = rs_tail_load(index);
+  if (s.j == 0u) return;  // ended in an earlier dispatch
+  RngState rng = rs_shading_rng(pixel);
+  rng.counter = s.rngCounter;
+  bool ended = rs_tail_advance(s, rng);
+  s.rngCounter = rng.counter;
+  if (ended) rs_accumulate(index, s.shaded + s.L, restart);
+  rs_tail_store(index, s);
+}
+#endif
 
 #endif

@@ -25,6 +25,18 @@ PLUME_NS_BEGIN
 
 const uint RS_MAX_VERTICES = 16u;  // longest path a reservoir stores (render.restir_prefix <= this)
 const uint RS_MAX_NEIGHBOURS = 8u;
+// Final shading's tail (restir/shade.glsl) walks at most this many segments, each with a light
+// ray, per dispatch of passes/restir_tail.comp: a bounded share of lavapipe's loop budget
+// (docs/architecture.md) whatever max_bounces is. (32 per dispatch still had no cut in the dense
+// bright cloud at 256 bounces, 128 had: notes/extreme.md.)
+const uint RS_TAIL_SEGMENTS = 8u;
+// The candidates walk at most this many vertices per invocation and dispatch (several walks of
+// K vertices, or one; restir/candidates.glsl). (M 16 x K 16 = 256 had no cut in the dense bright
+// cloud, M 64 x K 16 in one dispatch had: notes/extreme.md.)
+const uint RS_CANDIDATE_VERTICES = 64u;
+// vec4s per pixel of a pass's state between its dispatches (restir/bridge.glsl rs_state_slot):
+// the candidates' running reservoir (1), the tail's walk (5, restir/shade.glsl RsTail).
+const uint RS_STATE_SLOTS = 5u;
 const uint RS_LIGHT_EMISSION = 0xFFFFFFFFu;  // RsPathHead.light of a path ending in emission
 
 const uint RS_MIS_PAIRWISE = 0u;  // pairwise MIS with confidence weights (default, O(k))
@@ -64,7 +76,7 @@ struct RestirParams {
   // Candidates and final shading: vertices a reservoir's path holds, min(restir_prefix,
   // max_bounces); final shading path-traces the paths with more (PLUME_RS_TAIL)
   uint prefixVertices;
-  uint pad1;
+  uint walksPerDispatch;    // candidates per dispatch: RS_CANDIDATE_VERTICES / walk length, at least 1
 };
 
 // Push constants: which reservoir sets a pass reads and writes.
@@ -74,7 +86,7 @@ struct RsPush {
   uint outSet;               // output set
   uint spatialRound;         // spatial reuse's round (its random stream)
   uint restartAccumulation;  // final shading: 1 restarts the accumulation, 0 adds to it
-  uint pad0;
+  uint candidate;            // candidates: the first walk m < M of this dispatch
   uint pad1;
   uint pad2;
 };

@@ -133,6 +133,14 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   spatial_ = make("passes/restir_reuse.comp", "restir spatial", {{"PLUME_RS_TEMPORAL", "0"}});
   shade_ = make("passes/restir_shade.comp", "restir shade",
                 tail ? gpu::ShaderDefines{{"PLUME_RS_TAIL", "1"}} : gpu::ShaderDefines{});
+  // The tail's walk goes on in dispatches of at most RS_TAIL_SEGMENTS segments each (lavapipe's
+  // loop budget, docs/architecture.md): enough of them for the longest walk, max_bounces
+  // segments (one more in an emitting medium).
+  if (tail) {
+    tail_ = make("passes/restir_tail.comp", "restir tail", {});
+    const uint32_t segments = uint32_t(scene.render.maxBounces) + (features_.emission ? 1u : 0u);
+    tailDispatches_ = (segments + shared::RS_TAIL_SEGMENTS - 1) / shared::RS_TAIL_SEGMENTS;
+  }
 
   const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   const size_t pixels = size_t(scene.camera.width) * scene.camera.height;
@@ -146,12 +154,14 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   reservoirs_ = gpu::Buffer(ctx, kSets * pixels * sizeof(shared::RsPacked), storage, "reservoirs");
   paths_ = gpu::Buffer(ctx, kSets * pixels * sizeof(shared::RsPathHead), storage, "reservoir paths");
   bounces_ = gpu::Buffer(ctx, kSets * pixels * stride * sizeof(glm::vec4), storage, "reservoir path vertices");
-  output_ = gpu::Buffer(ctx, 2 * pixels * sizeof(glm::vec4), storage, "restir accumulation");
+  // The accumulation, then each pixel's state between the dispatches of a pass (the candidates'
+  // running reservoir, the tail's walk: restir/bridge.glsl rs_state_slot).
+  output_ = gpu::Buffer(ctx, (2 + shared::RS_STATE_SLOTS) * pixels * sizeof(glm::vec4), storage, "restir accumulation");
   counters_ = gpu::Buffer(ctx, 16, storage, "restir counters");
   counters_.fillZero();
   reservoirs_.fillZero();
   paths_.fillZero();
-  for (gpu::ComputePass* p : {candidates_.get(), temporal_.get(), spatial_.get(), shade_.get()}) {
+  for (gpu::ComputePass* p : passes()) {
     p->set.bind(shared::BIND_FRAME, frameBuffer_);
     p->set.bind(shared::BIND_LIGHTS, lightBuffer_);
     p->set.bind(shared::BIND_LIGHT_CHOICE, lightChoice_);
@@ -166,6 +176,7 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   params_.candidates = uint32_t(options_.candidates);
   params_.bounceStride = stride;
   params_.prefixVertices = uint32_t(prefix);
+  params_.walksPerDispatch = std::max(1u, shared::RS_CANDIDATE_VERTICES / uint32_t(features_.emission ? emitting : prefix));
   params_.pixelCount = uint32_t(pixels);
   params_.lightCount = uint32_t(scene.lights.size());
   params_.historyCap = float(options_.historyCap);
@@ -176,7 +187,7 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
 
 void Restir::setVolumes(const GpuVolumeResources& current, const GpuVolumeResources& previous) {
   PLUME_CHECK(current.hasMeanField() && previous.hasMeanField());  // baked with BakeOptions::meanField
-  for (gpu::ComputePass* p : {candidates_.get(), temporal_.get(), spatial_.get(), shade_.get()}) {
+  for (gpu::ComputePass* p : passes()) {
     current.bind(p->set);
     current.bindMeanField(p->set);
     previous.bindAsPrevious(p->set);
@@ -190,6 +201,12 @@ void Restir::setVolumes(const GpuVolumeResources& current, const GpuVolumeResour
   previousSerial_ = previous.serial();
   const std::vector<shared::GpuLightChoice> choice = lightChoice(scene_, centre, envMap_->meanRadiance());
   lightChoice_.upload(choice.data(), choice.size() * sizeof(shared::GpuLightChoice));
+}
+
+std::vector<gpu::ComputePass*> Restir::passes() const {
+  std::vector<gpu::ComputePass*> p = {candidates_.get(), temporal_.get(), spatial_.get(), shade_.get()};
+  if (tail_) p.push_back(tail_.get());
+  return p;
 }
 
 void Restir::resetHistory() { hasHistory_ = false; }
@@ -233,7 +250,14 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
     uint32_t cur = (hist + 1) % kSets;
     shared::RsPush push{};
     push.outSet = cur;
-    candidates_->record(cmd, items, &push, &timer_);
+    // walksPerDispatch candidate walks per dispatch (lavapipe's loop budget: restir/candidates.glsl).
+    const uint32_t candidates = timer_.begin(cmd, "restir candidates");
+    for (uint32_t m = 0; m < params_.candidates; m += params_.walksPerDispatch) {
+      if (m > 0) gpu::computeBarrier(cmd);
+      push.candidate = m;
+      candidates_->record(cmd, items, &push);
+    }
+    timer_.end(cmd, candidates);
     labels.push_back("candidates");
     gpu::computeBarrier(cmd);
     if (temporal) {
@@ -264,6 +288,15 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
     push.restartAccumulation = accumulate ? 0u : 1u;
     shade_->record(cmd, items, &push, &timer_);
     labels.push_back("shade");
+    if (tail_) {
+      const uint32_t scope = timer_.begin(cmd, "restir tail");
+      for (uint32_t i = 0; i < tailDispatches_; ++i) {
+        gpu::computeBarrier(cmd);
+        tail_->record(cmd, items, &push);
+      }
+      timer_.end(cmd, scope);
+      labels.push_back(strf("tail x%u", tailDispatches_));
+    }
     finalSet = cur;
   });
   passTimes_ = timer_.read();

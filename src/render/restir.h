@@ -1,6 +1,8 @@
 // Volumetric ReSTIR on the GPU (DESIGN §4.2): per frame, candidates -> temporal reuse ->
-// spatial reuse x R -> final shading, four compute passes (shaders/passes/restir_*.comp) over
-// three reservoir sets that rotate (the last frame's final set is the history). The host only
+// spatial reuse x R -> final shading (-> its tail), compute passes (shaders/passes/restir_*.comp)
+// over three reservoir sets that rotate (the last frame's final set is the history). Candidates
+// and the tail are dispatched several times, each dispatch a bounded share of the work
+// (lavapipe's loop budget: notes/restir.md "Bounded work per dispatch"). The host only
 // fills parameter blocks and picks sets; all reservoir arithmetic lives in the shaders
 // (shared/reservoir.h, shared/restir_types.h, restir/*.glsl).
 //
@@ -21,6 +23,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace plume {
 
@@ -74,6 +77,7 @@ class Restir {
 
  private:
   void fillFrame(int frame, uint32_t sequence, uint32_t key);
+  std::vector<gpu::ComputePass*> passes() const;
 
   gpu::Context& ctx_;
   const Scene& scene_;
@@ -81,6 +85,8 @@ class Restir {
   FeatureSet features_;
   std::unique_ptr<GpuEnvironmentMap> envMap_;
   std::unique_ptr<gpu::ComputePass> candidates_, temporal_, spatial_, shade_;
+  std::unique_ptr<gpu::ComputePass> tail_;  // final shading's tail (null without one)
+  uint32_t tailDispatches_ = 0;             // its dispatches per frame
   gpu::GpuTimer timer_;
   gpu::Buffer frameBuffer_, lightBuffer_, lightChoice_, paramBuffer_, reservoirs_, paths_, bounces_, output_, counters_;
   shared::GpuFrame frame_{};

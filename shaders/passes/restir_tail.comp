@@ -1,0 +1,20 @@
+// ReSTIR pass 4b (DESIGN §4.2 step 7, with a tail): one dispatch of final shading's tail, at most
+// RS_TAIL_SEGMENTS segments of each pixel's walk (restir/shade.glsl); the host dispatches it until
+// every walk has ended (Restir::render). push.restartAccumulation as for pass 4.
+#version 450
+#extension GL_GOOGLE_include_directive : require
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+#define PLUME_RS_TAIL 1
+#include "../restir/bindings.glsl"
+#include "../restir/bridge.glsl"
+#include "../restir/shade.glsl"
+#include "../volume/loop_guard.glsl"
+
+void main() {
+  uvec2 pixel = gl_GlobalInvocationID.xy;
+  if (pixel.x >= frame.size.x || pixel.y >= frame.size.y) return;
+  rs_tail_pixel(pixel, push.restartAccumulation != 0u);
+  loop_guard_check(frame.loopProbe);
+}
