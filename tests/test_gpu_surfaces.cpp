@@ -3,18 +3,18 @@
 // and aggregate Z-tests against the CPU reference (which intersects with Embree itself, not the
 // flattened tree) on smoke over a ground, an occluder and a glossy conductor, and emissive quads
 // as the only lights; and a scene without surfaces compiles no traversal and builds no BVH.
-#include "reference/reference.h"
 #include "render/features.h"
+#include "render/gpu_surfaces.h"
 #include "render/path_tracer.h"
 #include "shaders/shared/bindings.h"
 #include "support/gpu_fixture.h"
 #include "support/grids.h"
-#include "support/reference_check.h"
 #include "support/scenes.h"
 
 #include <glm/glm.hpp>
 
 #include <cmath>
+#include <random>
 
 using namespace plume;
 
@@ -55,25 +55,9 @@ Scene groundScene(int size, int bounces) {
   return s;
 }
 
-Image reference(Scene s, openvdb::FloatGrid::Ptr grid, int spp) {
-  s.render.spp = spp;
-  s.render.seed = 4242;
-  ref::ReferenceOptions opt;
-  opt.progress = false;
-  return ref::renderReference(s, grid, opt);
-}
-
-void renderAndCompare(gpu::Context& ctx, gpu::ShaderCompiler& compiler, Scene s, openvdb::FloatGrid::Ptr grid,
+void renderAndCompare(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& s, openvdb::FloatGrid::Ptr grid,
                       int gpuSpp, int refSpp, const std::string& name) {
-  const Image refImage = reference(s, grid, refSpp);
-  s.render.spp = gpuSpp;
-  test::GpuRenderInfo info;
-  const Image gpuImage = test::renderGpuPt(ctx, compiler, s, grid, 1, &info);
-  EXPECT_NE(info.variant.find("surfaces"), std::string::npos) << info.variant;
-  EXPECT_EQ(info.truncated, 0u) << name;
-  test::ReferenceCheckOptions options;
-  options.outputGroup = "gpu_surfaces";
-  test::expectMatchesReference(gpuImage, refImage, name, options);
+  test::expectPtMatchesReference(ctx, compiler, s, grid, gpuSpp, refSpp, name, "gpu_surfaces", "surfaces");
 }
 
 // SPIR-V decorates a descriptor binding as OpDecorate (opcode 71) <id> Binding (33) <n>.
@@ -179,4 +163,32 @@ TEST_F(GpuSurfaceTest, ASceneWithoutSurfacesCompilesNoTraversal) {
   }
   EXPECT_FALSE(PathTracer(ctx(), compiler(), without).hasSurfaces());
   EXPECT_TRUE(PathTracer(ctx(), compiler(), with).hasSurfaces());
+}
+
+// The emitters' alias table chooses triangle i with probability w_i / sum w: the probability each
+// entry implies (its own keep, plus the rest of every entry that hands over to it, over n) equals
+// the weight's share, for spread, equal and one-dominant weights.
+TEST(EmitterAliasTable, ChoosesEachTriangleInProportionToItsWeight) {
+  std::mt19937 gen(7);
+  std::uniform_real_distribution<double> logw(-3.0, 3.0);
+  std::vector<std::vector<double>> cases = {{}, std::vector<double>(50, 2.0), {1e6, 1.0, 1.0, 1.0}, {3.0}};
+  for (int i = 0; i < 1000; ++i) cases[0].push_back(std::pow(10.0, logw(gen)));
+  for (const std::vector<double>& w : cases) {
+    std::vector<uint32_t> triangles(w.size());
+    for (size_t i = 0; i < w.size(); ++i) triangles[i] = uint32_t(1000 + 3 * i);
+    const std::vector<shared::GpuEmitterAlias> table = emitterAliasTable(w, triangles);
+    ASSERT_EQ(table.size(), w.size());
+    std::vector<double> p(w.size(), 0.0);
+    for (size_t i = 0; i < table.size(); ++i) {
+      ASSERT_EQ(table[i].triangle, triangles[i]);
+      ASSERT_GE(table[i].keep, 0.0f);
+      ASSERT_LE(table[i].keep, 1.0f);
+      ASSERT_LT(table[i].alias, table.size());
+      p[i] += double(table[i].keep) / double(w.size());
+      p[table[i].alias] += (1.0 - double(table[i].keep)) / double(w.size());
+    }
+    double total = 0.0;
+    for (double x : w) total += x;
+    for (size_t i = 0; i < w.size(); ++i) EXPECT_NEAR(p[i], w[i] / total, 1e-7 + 1e-6 * w[i] / total) << i << " of " << w.size();
+  }
 }

@@ -38,4 +38,17 @@ SceneMesh loadSceneSurfaces(const Scene& scene) {
   return out;
 }
 
+shared::Bsdf surfaceBsdf(const Surface& s) {
+  shared::Bsdf b{};
+  if (s.material == SurfaceMaterial::Conductor) {
+    b.type = shared::BSDF_CONDUCTOR;
+    b.color = s.f0;
+    b.alpha = s.roughness;
+  } else {
+    b.type = shared::BSDF_DIFFUSE;
+    b.color = s.albedo;
+  }
+  return b;
+}
+
 }  // namespace plume::geo

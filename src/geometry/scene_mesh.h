@@ -6,6 +6,7 @@
 
 #include "geometry/mesh.h"
 #include "scene/scene.h"
+#include "shaders/shared/bsdf.h"
 
 #include <vector>
 
@@ -20,5 +21,9 @@ struct SceneMesh {
 // Throws InputError: an OBJ's errors name its file and line, a transform's name
 // "<scene>: surfaces[i].transform", a surface left without triangles names "surfaces[i]".
 SceneMesh loadSceneSurfaces(const Scene& scene);
+
+// The surface's material as the BSDF of shared/bsdf.h (diffuse albedo, or a conductor's f0 and
+// GGX alpha); emission is not a BSDF property.
+shared::Bsdf surfaceBsdf(const Surface& s);
 
 }  // namespace plume::geo

@@ -13,29 +13,12 @@ namespace plume::ref {
 using glm::dvec3;
 namespace sh = plume::shared;
 
-namespace {
-
-sh::Bsdf bsdfOf(const Surface& s) {
-  sh::Bsdf b{};
-  if (s.material == SurfaceMaterial::Conductor) {
-    b.type = sh::BSDF_CONDUCTOR;
-    b.color = s.f0;
-    b.alpha = s.roughness;
-  } else {
-    b.type = sh::BSDF_DIFFUSE;
-    b.color = s.albedo;
-  }
-  return b;
-}
-
-}  // namespace
-
 ReferenceSurfaces::ReferenceSurfaces(const Scene& scene) {
   geo::SceneMesh sm = geo::loadSceneSurfaces(scene);
   mesh_ = std::move(sm.mesh);
   triangleSurface_ = std::move(sm.triangleSurface);
   for (const Surface& s : scene.surfaces) {
-    bsdfs_.push_back(bsdfOf(s));
+    bsdfs_.push_back(geo::surfaceBsdf(s));
     emission_.push_back(dvec3(s.emission));
   }
   const size_t n = mesh_.triangleCount();

@@ -13,21 +13,21 @@
 namespace plume {
 namespace {
 
-shared::Bsdf bsdfOf(const Surface& s) {
-  shared::Bsdf b{};
-  if (s.material == SurfaceMaterial::Conductor) {
-    b.type = shared::BSDF_CONDUCTOR;
-    b.color = s.f0;
-    b.alpha = s.roughness;
-  } else {
-    b.type = shared::BSDF_DIFFUSE;
-    b.color = s.albedo;
+template <typename T>
+gpu::Buffer upload(gpu::Context& ctx, const std::vector<T>& data, const char* name) {
+  const VkDeviceSize bytes = std::max<VkDeviceSize>(sizeof(T), data.size() * sizeof(T));
+  if (bytes > ctx.limits().maxStorageBufferRange) {
+    throw InputError(strf("surfaces: the %s need %.0f MiB, more than this device's storage buffers hold (%.0f MiB)",
+                          name, double(bytes) / 1048576.0, double(ctx.limits().maxStorageBufferRange) / 1048576.0));
   }
+  gpu::Buffer b(ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, name);
+  if (!data.empty()) b.upload(data.data(), data.size() * sizeof(T));
   return b;
 }
 
-// Walker's alias table (Vose's construction, in double) over weights w_i > 0.
-std::vector<shared::GpuEmitterAlias> aliasTable(const std::vector<double>& weights,
+}  // namespace
+
+std::vector<shared::GpuEmitterAlias> emitterAliasTable(const std::vector<double>& weights,
                                                 const std::vector<uint32_t>& triangles) {
   const size_t n = weights.size();
   double total = 0.0;
@@ -54,20 +54,6 @@ std::vector<shared::GpuEmitterAlias> aliasTable(const std::vector<double>& weigh
   return table;  // the entries left in either list keep themselves (probability 1, up to rounding)
 }
 
-template <typename T>
-gpu::Buffer upload(gpu::Context& ctx, const std::vector<T>& data, const char* name) {
-  const VkDeviceSize bytes = std::max<VkDeviceSize>(sizeof(T), data.size() * sizeof(T));
-  if (bytes > ctx.limits().maxStorageBufferRange) {
-    throw InputError(strf("surfaces: the %s need %.0f MiB, more than this device's storage buffers hold (%.0f MiB)",
-                          name, double(bytes) / 1048576.0, double(ctx.limits().maxStorageBufferRange) / 1048576.0));
-  }
-  gpu::Buffer b(ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, name);
-  if (!data.empty()) b.upload(data.data(), data.size() * sizeof(T));
-  return b;
-}
-
-}  // namespace
-
 GpuSurfaces::GpuSurfaces(gpu::Context& ctx, const Scene& scene) {
   const geo::SceneMesh sm = geo::loadSceneSurfaces(scene);
   const geo::TriangleMesh& mesh = sm.mesh;
@@ -78,7 +64,7 @@ GpuSurfaces::GpuSurfaces(gpu::Context& ctx, const Scene& scene) {
   std::vector<shared::GpuSurfaceMaterial> materials;
   for (const Surface& s : scene.surfaces) {
     shared::GpuSurfaceMaterial m{};
-    m.bsdf = bsdfOf(s);
+    m.bsdf = geo::surfaceBsdf(s);
     m.emission = s.emission;
     materials.push_back(m);
   }
@@ -118,7 +104,7 @@ GpuSurfaces::GpuSurfaces(gpu::Context& ctx, const Scene& scene) {
   bvhTriangles_ = upload(ctx, bvh.triangles, "BVH triangles");
   triangles_ = upload(ctx, triangles, "surface triangles");
   materials_ = upload(ctx, materials, "surface materials");
-  emitters_ = upload(ctx, emitters.empty() ? std::vector<shared::GpuEmitterAlias>{} : aliasTable(power, emitters),
+  emitters_ = upload(ctx, emitters.empty() ? std::vector<shared::GpuEmitterAlias>{} : emitterAliasTable(power, emitters),
                      "emitter table");
   uploadMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   logInfo(strf("surfaces: %zu triangles (%u emissive), BVH %zu nodes, %.1f bytes/triangle on the device; built in %.0f ms",

@@ -8,10 +8,18 @@
 #include "geometry/bvh.h"
 #include "gpu/pipeline.h"
 #include "scene/scene.h"
+#include "shaders/shared/surface_types.h"
 
 #include <cstdint>
+#include <vector>
 
 namespace plume {
+
+// Walker's alias table (Vose's construction, in double) over weights w_i > 0, entry i naming
+// triangles[i]: surface/surfaces.glsl picks entry i with probability 1/n and keeps it with
+// probability keep, else takes entry alias, so triangle i is chosen with probability w_i / sum w.
+std::vector<shared::GpuEmitterAlias> emitterAliasTable(const std::vector<double>& weights,
+                                                       const std::vector<uint32_t>& triangles);
 
 class GpuSurfaces {
  public:

@@ -1,8 +1,10 @@
 #include "support/gpu_fixture.h"
 
 #include "media/vdb_loader.h"
+#include "reference/reference.h"
 #include "render/gpu_volume.h"
 #include "render/path_tracer.h"
+#include "support/reference_check.h"
 
 namespace plume::test {
 
@@ -67,6 +69,25 @@ Image renderGpuPt(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene&
     info->truncated = volume.truncatedCount() + volume.loopLimitCount();  // both are truncations
   }
   return tracer.readImage();
+}
+
+void expectPtMatchesReference(gpu::Context& ctx, gpu::ShaderCompiler& compiler, Scene s, openvdb::FloatGrid::Ptr grid,
+                              int gpuSpp, int refSpp, const std::string& name, const std::string& outputGroup,
+                              const std::string& feature) {
+  Scene refScene = s;
+  refScene.render.spp = refSpp;
+  refScene.render.seed = 4242;
+  ref::ReferenceOptions opt;
+  opt.progress = false;
+  const Image ref = ref::renderReference(refScene, grid, opt);
+  s.render.spp = gpuSpp;
+  GpuRenderInfo info;
+  const Image gpu = renderGpuPt(ctx, compiler, s, grid, 1, &info);
+  EXPECT_NE(info.variant.find(feature), std::string::npos) << info.variant;
+  ReferenceCheckOptions options;
+  options.outputGroup = outputGroup;
+  expectMatchesReference(gpu, ref, name, options);
+  EXPECT_EQ(info.truncated, 0u) << name;
 }
 
 }  // namespace plume::test

@@ -44,4 +44,12 @@ Image renderGpuPt(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene&
                   openvdb::FloatGrid::Ptr grid, int frame = 1, GpuRenderInfo* info = nullptr,
                   TexelFormat format = TexelFormat::Float16, openvdb::FloatGrid::Ptr emission = nullptr);
 
+// Renders `scene` with the GPU path tracer at gpuSpp and with the CPU reference at refSpp (seed
+// 4242) and expects them to agree (support/reference_check.h: per-pixel and aggregate z-tests,
+// outputs under `outputGroup`), with no truncation, in a shader variant whose name contains
+// `feature`.
+void expectPtMatchesReference(gpu::Context& ctx, gpu::ShaderCompiler& compiler, Scene scene,
+                              openvdb::FloatGrid::Ptr grid, int gpuSpp, int refSpp, const std::string& name,
+                              const std::string& outputGroup, const std::string& feature);
+
 }  // namespace plume::test
