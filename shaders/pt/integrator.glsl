@@ -97,8 +97,7 @@ vec3 pt_direct(PathVertex v, inout RngState rng) {
 // The environment map seen by a path that escapes along dir after a vertex that drew dir by
 // phase sampling with pdf phasePdf: its power-heuristic weight against the map's NEE.
 vec3 pt_escaped_map(vec3 dir, float phasePdf) {
-  float pl = env_pdf(envMap, dir);
-  return env_radiance(envMap, dir) * (phasePdf * phasePdf / (phasePdf * phasePdf + pl * pl));
+  return env_radiance(envMap, dir) * pt_power_heuristic(phasePdf, env_pdf(envMap, dir));
 }
 #endif
 
@@ -160,19 +159,20 @@ bool pt_extend(uint slot, bool camera) {
 #ifdef PLUME_HAS_SURFACES
   else if (hit.prim != BVH_NONE) {
     vertex = true;
-    vec3 le = surf_emitted(hit.prim, p.dir);
+    vec3 n = surf_normal(hit.prim);
+    vec3 le = surf_emitted(hit.prim, n, p.dir);
 #ifdef PLUME_HAS_EMITTERS
     // After a vertex, weighted against that vertex's emitter sampling (its area density turned
     // into solid angle at the vertex: distance² / cosine).
     if (p.scatterings > 0u && any(greaterThan(le, vec3(0.0f)))) {
-      float pdfLight = surf_emitter_pdf(hit.prim) * hit.t * hit.t / abs(dot(surf_normal(hit.prim), p.dir));
+      float pdfLight = surf_emitter_pdf(hit.prim) * hit.t * hit.t / abs(dot(n, p.dir));
       le *= pt_power_heuristic(p.phasePdf, pdfLight);
     }
 #endif
     p.radiance += p.beta * le;
     p.origin += hit.t * p.dir;
     p.prim = hit.prim;
-    p.shading = surf_shading_normal(hit.prim, vec2(hit.u, hit.v), surf_normal(hit.prim));
+    p.shading = surf_shading_normal(hit.prim, vec2(hit.u, hit.v), n);
   }
 #endif
   else {

@@ -45,10 +45,10 @@ vec3 surf_shading_normal(uint prim, vec2 uv, vec3 geometric) {
 
 Bsdf surf_bsdf(uint prim) { return surfMaterials[surfTriangles[prim].surface].bsdf; }
 
-// The radiance a ray of direction dir sees where it hits triangle prim: the surface's emission
-// on the front side, nothing on the back.
-vec3 surf_emitted(uint prim, vec3 dir) {
-  return dot(surf_normal(prim), dir) < 0.0f ? surfMaterials[surfTriangles[prim].surface].emission : vec3(0.0f);
+// The radiance a ray of direction dir sees where it hits triangle prim (front normal n): the
+// surface's emission on the front side, nothing on the back.
+vec3 surf_emitted(uint prim, vec3 n, vec3 dir) {
+  return dot(n, dir) < 0.0f ? surfMaterials[surfTriangles[prim].surface].emission : vec3(0.0f);
 }
 
 float surf_offset_length(vec3 p) { return SURF_RELATIVE_OFFSET * (1.0f + plume_max3(abs(p))); }
