@@ -75,7 +75,9 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
       float trTarget = exp(-min(tau, VOL_MAX_TAU));  // the target's transmittance (same field)
       x += t * w;
       float sigma = vol_sigma_t_world(VOL_CURRENT, x);
-      if (!(sigma > 0.0f)) break;  // f = 0 for this path and every extension of it
+      // f = 0 for this path and every extension of it (sigmaC: an exact voxel's density at the
+      // collision, 0 only by rounding at the edge of a zero region, a set of measure 0)
+      if (!(sigma > 0.0f) || !(sigmaC > 0.0f)) break;
       pdf *= sigmaC * exp(-tau);   // the sampling field's free-flight pdf
       vec3 fArrive = f * trTarget * sigma;  // before x_j scatters or absorbs
       f = fArrive * vtx_albedo(VERTEX_MEDIUM);

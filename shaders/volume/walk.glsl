@@ -13,7 +13,12 @@
 //    bookkeeping costs more than it saves, +35% on the bundled smoke with lavapipe, so the host
 //    picks the variant from the size of the brick grid: render/path_tracer.cpp);
 //  - VOL_FIELD_MEAN: ReSTIR's per-voxel mean field, an outer DDA over bricks (an empty brick is
-//    one step) and an inner one over the voxels of each occupied brick.
+//    one step) and an inner one over the voxels of each occupied brick. Where the fine density
+//    strays far from a voxel's mean (its residual bound times the longest chord the ray can have
+//    through the voxel exceeds VOL_EXACT_TAU optical depths) the field there is the fine
+//    trilinear density itself, integrated exactly ("exact voxels", below): the ReSTIR field is
+//    then a deterministic function of the voxel and the ray's direction, positive wherever the
+//    fine density is, and close to it everywhere.
 // Requires volume/bindings.glsl and volume/grid.glsl.
 #ifndef PLUME_VOLUME_WALK_GLSL
 #define PLUME_VOLUME_WALK_GLSL
@@ -26,6 +31,13 @@
 
 const uint VOL_MAX_STEPS = 1u << 20;  // per tracking call; hits are counted in volCounters[0]
 const float VOL_MAX_TAU = 80.0f;      // the mean field's optical depth is clamped here: exp(-80) > 0
+// A mean-field voxel becomes exact when its residual bound (sigma_t units) times the longest chord
+// of the ray's direction through a voxel exceeds this: the mean field's optical depth then differs
+// from the fine one by at most this much per voxel elsewhere. (Measured on the 1e-30..1e30 grid
+// and the bundled scenes: notes/extreme.md "Exact voxels".)
+#ifndef PLUME_VOL_EXACT_TAU
+#define PLUME_VOL_EXACT_TAU 0.5f
+#endif
 
 const uint VOL_FIELD_MAJORANT = 0u;
 const uint VOL_FIELD_MEAN = 1u;
@@ -41,6 +53,15 @@ struct VolWalk {
   float scale; // VOL_FIELD_MEAN: the volume's density scale (read once, not per voxel)
   vec3 o;
   vec3 d;
+  // VOL_FIELD_MEAN's exact voxels: the residual bound above which a voxel is exact for this
+  // direction; the current brick's first voxel (index space) and first atlas texel; whether the
+  // last segment is exact, and its voxel's 8 corner texels.
+  float exactBound;
+  ivec3 brickVoxel;
+  ivec3 brickTexel;
+  bool exact;
+  ivec3 voxel;
+  ivec3 texel;
 };
 
 bool vol_walk_start(uint field, uint v, vec3 o, vec3 d, float tMax, out VolWalk w) {
@@ -51,6 +72,13 @@ bool vol_walk_start(uint field, uint v, vec3 o, vec3 d, float tMax, out VolWalk 
   w.scale = 0.0f;
   w.o = o;
   w.d = d;
+  // The longest chord of direction d through a unit index cube is 1 / max_i |d_i| world units.
+  w.exactBound = PLUME_VOL_EXACT_TAU * max(max(abs(d.x), abs(d.y)), abs(d.z));
+  w.brickVoxel = ivec3(0);
+  w.brickTexel = ivec3(0);
+  w.exact = false;
+  w.voxel = ivec3(0);
+  w.texel = ivec3(0);
   if (field == VOL_FIELD_MAJORANT) {
 #ifdef PLUME_SKIP_EMPTY
     if (vol.empty != 0 || vol.levelCount < 2u) return false;  // empty (or no level 1: host bug)
@@ -92,6 +120,9 @@ bool vol_walk_next(uint field, inout VolWalk w, out float a, out float b, out ve
         } else {
 #if defined(PLUME_VOL_MEAN_FIELD) || defined(PLUME_VOL_PREVIOUS)
           value = w.scale * vol_mean_field(w.v, w.base + uint((sub.z * VOL_BRICK + sub.y) * VOL_BRICK + sub.x));
+          w.exact = value.y > w.exactBound;
+          w.voxel = w.brickVoxel + sub;
+          w.texel = w.brickTexel + sub;
 #endif
         }
         return true;
@@ -115,6 +146,8 @@ bool vol_walk_next(uint field, inout VolWalk w, out float a, out float b, out ve
       uint slot = vol_packed_slot(w.v, brick);
       if (slot == 0u) continue;
       w.base = vol_mean_field_base(w.v, slot);
+      w.brickVoxel = brick * VOL_BRICK;
+      w.brickTexel = vol_slot_coords(slot) * VOL_TEXELS + 1;  // as vol_locate
       w.innerLive = dda_init(w.inner, w.o, w.d, oa, ob, vec3(brick * VOL_BRICK), 1.0f, ivec3(VOL_BRICK));
 #endif
     }
@@ -198,6 +231,77 @@ float vol_track_segment(uint tracker, inout VolTrack s, float a, float b, vec2 v
   return 0.0f;
 }
 
+#if defined(PLUME_VOL_MEAN_FIELD) || defined(PLUME_VOL_PREVIOUS)
+// --- Exact voxels of the mean field ----------------------------------------------------------------
+// Inside one voxel the fine density is one trilinear polynomial of its 8 corner texels (the
+// voxel of vol_locate), so along a segment it is a cubic in the segment's parameter u in [0, 1]:
+// two-point Gauss-Legendre integrates it exactly, and sampling inverts that integral (a
+// monotone quartic) by safeguarded Newton steps. The density at the collision is the one the
+// pdf needs, sigma exp(-tau), as for a constant voxel.
+struct VolExact {
+  float c[8];  // corner texels, vol_corner_weight's order
+  vec3 fa;     // fractions in the voxel at the segment's start
+  vec3 df;     // their change over the segment
+};
+
+VolExact vol_exact_start(VolWalk w, float a, float b) {
+  VolExact e;
+  for (int k = 0; k < 8; ++k) e.c[k] = vol_texel(w.v, w.texel + ivec3(k & 1, (k >> 1) & 1, k >> 2));
+  vec3 base = vec3(w.voxel);
+  e.fa = w.o + a * w.d - base;
+  e.df = (w.o + b * w.d - base) - e.fa;
+  return e;
+}
+
+// The density at parameter u of the segment (not yet multiplied by the density scale).
+float vol_exact_density(VolExact e, float u) {
+  vec3 f = clamp(e.fa + u * e.df, vec3(0.0f), vec3(1.0f));
+  float sum = 0.0f;
+  for (int c = 0; c < 8; ++c) sum += vol_corner_weight(c, f) * e.c[c];
+  return sum;
+}
+
+// Its integral over (0, u).
+float vol_exact_integral(VolExact e, float u) {
+  float h = 0.5f * u;
+  float g = 0.57735026918962576f * h;  // h / sqrt(3)
+  return h * (vol_exact_density(e, h - g) + vol_exact_density(e, h + g));
+}
+
+// vol_track_segment for an exact voxel: TAU adds, RESIDUAL multiplies by the exact transmittance
+// (the residual is 0: no tentative collisions), SAMPLE finds its collision here or passes on.
+float vol_track_exact(uint tracker, inout VolTrack s, VolWalk w, float scale, float a, float b) {
+  VolExact e = vol_exact_start(w, a, b);
+  float len = scale * (b - a);
+  float total = len * vol_exact_integral(e, 1.0f);
+  if (tracker == VOL_TRACK_RESIDUAL) {
+    s.value *= exp(-total);
+  } else if (tracker == VOL_TRACK_TAU) {
+    s.value += total;
+  } else if (total > 0.0f && total >= s.value) {  // VOL_TRACK_SAMPLE: the collision is here
+    float r = s.value / len;  // the density's integral still to go, over u
+    float lo = 0.0f;
+    float hi = 1.0f;
+    float u = clamp(s.value / total, 0.0f, 1.0f);
+    for (int i = 0; i < 40; ++i) {
+      float F = vol_exact_integral(e, u) - r;
+      if (abs(F) <= 1e-6f * r) break;
+      if (F < 0.0f) lo = u; else hi = u;
+      if (hi - lo <= 1e-7f) break;
+      float p = vol_exact_density(e, u);
+      float next = p > 0.0f ? u - F / p : -1.0f;
+      u = (next > lo && next < hi) ? next : 0.5f * (lo + hi);
+    }
+    s.t = a + u * (b - a);
+    s.sigma = scale * vol_exact_density(e, u);
+    s.hit = true;
+  } else {
+    s.value -= total;
+  }
+  return 0.0f;
+}
+#endif
+
 // At a tentative collision at distance t (index-space point p) of rate mu, in a segment of field
 // value `value`, in volume v of density scale `scale`; u is a uniform number drawn with the step.
 void vol_track_event(uint tracker, inout VolTrack s, uint v, float scale, vec3 p, float t, float mu, vec2 value,
@@ -277,7 +381,15 @@ VolTrack vol_track(uint tracker, uint v, vec3 xWorld, vec3 wWorld, float tMax, f
 #ifdef PLUME_KERNEL_COUNTERS
     vol_kc_segment(kc);
 #endif
-    float mu = vol_track_segment(tracker, s, a, b, value);
+    float mu;
+#if defined(PLUME_VOL_MEAN_FIELD) || defined(PLUME_VOL_PREVIOUS)
+    if (field == VOL_FIELD_MEAN && w.exact) {
+      mu = vol_track_exact(tracker, s, w, scale, a, b);
+    } else
+#endif
+    {
+      mu = vol_track_segment(tracker, s, a, b, value);
+    }
     if (!(mu > 0.0f)) continue;
     float t = a;
     for (;;) {
