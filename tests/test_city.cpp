@@ -206,3 +206,24 @@ TEST_F(CityGpuTest, PathTracerMatchesReferenceOnTheBundledCity) {
       test::expectPtMatchesReference(ctx(), compiler(), s, grid.grid, 1024, 2048, "city", "city", "emitters", 0.8f);
   EXPECT_LT(check.aggregate.resolvableBias().x, 0.15) << "too few samples for the test to mean much";
 }
+
+// The bundled city on the device: 11922 triangles (the ground's 2, 392 boxes of 5 quads, 4000
+// emissive quads), 8000 of them emitters; prints the BVH's figures (notes/city.md), with and
+// without spatial splits.
+TEST_F(CityGpuTest, SurfacesOnTheDevice) {
+  const Scene s = loadScene(test::sourcePath("volumes/city/city.json"));
+  const GpuSurfaces surfaces(ctx(), s);
+  EXPECT_EQ(surfaces.emitterCount(), 8000u);
+  const geo::BvhStats& st = surfaces.bvhStats();
+  EXPECT_EQ(st.inputTriangles, 11922u);
+  std::printf("city on the device: %zu triangles, %u emissive; BVH %zu nodes, %zu leaves, %zu references, depth %d, "
+              "%.1f bytes/triangle (nodes + leaves); Embree build %.1f ms, flatten %.1f ms; all surface buffers "
+              "built and uploaded in %.1f ms\n",
+              st.inputTriangles, surfaces.emitterCount(), st.nodes, st.leaves, st.references, st.depth,
+              st.bytesPerTriangle(), st.buildMs, st.flattenMs, surfaces.uploadMs());
+  const geo::TriangleMesh mesh = geo::loadSceneSurfaces(s).mesh;
+  const geo::BvhStats plain = geo::buildBvh(mesh, {.spatialSplits = false}).stats;
+  std::printf("without spatial splits: %zu nodes, %zu references, depth %d, %.1f bytes/triangle, Embree build %.1f ms\n",
+              plain.nodes, plain.references, plain.depth, plain.bytesPerTriangle(), plain.buildMs);
+  EXPECT_EQ(plain.references, plain.inputTriangles);
+}
