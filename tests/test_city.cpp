@@ -193,7 +193,7 @@ class CityGpuTest : public test::GpuTest {};
 // streets behind it, 3 bounces (smoke, ground, buildings), frame 24's grid. Light sampling picks
 // one of 8000 lamps by power alone, so the images are noisy: the aggregate test resolves about
 // 8%; the same comparison with the path tracer's image scaled by 0.8 must fail.
-// (test_city_slow.cpp: the whole picture at 32 x 32, resolving about 3%.)
+// (test_city_slow.cpp: the whole picture at 32 x 32, resolving about 2%.)
 TEST_F(CityGpuTest, PathTracerMatchesReferenceOnTheBundledCity) {
   Scene s = loadScene(test::sourcePath("volumes/city/city.json"));
   s.camera.width = s.camera.height = 20;
