@@ -13,6 +13,7 @@
 #include "volgen.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -120,65 +121,78 @@ void checkParams(const CityParams& p) {
   if (!(p.maxHeight > kFloorPitch && p.maxHeight <= 100.0)) bad("--max-height must be in (0.034, 100]");
 }
 
-}  // namespace
+struct Box {
+  float x0, z0, wx, wz;  // a corner and the footprint's size
+  int storeys;
+};
 
-int runCity(const CityParams& p) {
-  checkParams(p);
-  const uint32_t seed = p.seed;
-  std::vector<std::array<float, 5>> boxes;  // x0 x1 z0 z1 h
-  std::vector<Slot> windows, lamps;
-  const int cells = int(std::ceil(p.radius / p.block)) + 1;
+struct City {
+  std::vector<Box> boxes;
+  std::vector<Slot> windows, lamps;  // every slot; the chosen ones after keepSmallest
+};
+
+// The window slots on a box's four walls, one per storey and column, facing out. A building's own
+// share of lit windows varies (`litBias` scales its keys), and its light is warm or cool.
+void addWindows(City& city, const Box& b, uint32_t seed, uint32_t lot, double coolShare) {
+  const float litBias = hashUnit(seed, lot, 7);
+  const bool coolBuilding = hashUnit(seed, lot, 8) < coolShare;
+  const float wx = b.wx, wz = b.wz;
+  uint32_t slot = 0;
+  for (int wall = 0; wall < 4; ++wall) {
+    const int n = wall < 2 ? 0 : 2;  // walls facing x, then z
+    const float sign = (wall % 2) ? 1.0f : -1.0f;
+    const float len = n == 0 ? wz : wx;
+    const int cols = int((len - 0.008f) / kWindowPitch);
+    const float start = (n == 0 ? b.z0 : b.x0) + 0.5f * (len - float(cols - 1) * kWindowPitch);
+    for (int s = 0; s < b.storeys; ++s) {
+      for (int col = 0; col < cols; ++col, ++slot) {
+        float c[3];
+        c[1] = (float(s) + 0.55f) * kFloorPitch;
+        const float along = start + float(col) * kWindowPitch;
+        if (n == 0) {
+          c[0] = (sign > 0 ? b.x0 + wx : b.x0) + sign * kWindowGap;
+          c[2] = along;
+        } else {
+          c[0] = along;
+          c[2] = (sign > 0 ? b.z0 + wz : b.z0) + sign * kWindowGap;
+        }
+        const float key = hashUnit(seed, lot, 100 + slot) * (0.3f + 0.7f * litBias);
+        city.windows.push_back({axisQuad(c, n, sign, kWindowSize[0], kWindowSize[1]), key, coolBuilding});
+      }
+    }
+  }
+}
+
+// Lots: cell (i, k) spans [i, i+1] x [k, k+1] blocks and streets run along the cell edges; a lot
+// whose centre lies between the plaza and the radius holds one box (or is a park).
+void addBuildings(City& city, const CityParams& p, int cells) {
   const float half = 0.5f * float(p.street);
-  // Lots: cell (i, k) spans [i, i+1] x [k, k+1] blocks; streets run along the cell edges.
   for (int i = -cells; i < cells; ++i) {
     for (int k = -cells; k < cells; ++k) {
       const float cx = (float(i) + 0.5f) * float(p.block), cz = (float(k) + 0.5f) * float(p.block);
       const float r = std::hypot(cx, cz);
       if (r < p.plaza + 0.5 * p.block || r > p.radius) continue;
       const uint32_t lot = uint32_t(i + 1000) * 4096u + uint32_t(k + 1000);
-      if (hashUnit(seed, lot, 1) < kParkShare) continue;
+      if (hashUnit(p.seed, lot, 1) < kParkShare) continue;
       // The footprint: 60-100% of the lot on each axis, placed anywhere in it.
       const float lotW = float(p.block) - float(p.street);
-      const float wx = lotW * (0.6f + 0.4f * hashUnit(seed, lot, 2)), wz = lotW * (0.6f + 0.4f * hashUnit(seed, lot, 3));
-      const float x0 = float(i) * float(p.block) + half + (lotW - wx) * hashUnit(seed, lot, 4);
-      const float z0 = float(k) * float(p.block) + half + (lotW - wz) * hashUnit(seed, lot, 5);
+      const float wx = lotW * (0.6f + 0.4f * hashUnit(p.seed, lot, 2)), wz = lotW * (0.6f + 0.4f * hashUnit(p.seed, lot, 3));
+      const float x0 = float(i) * float(p.block) + half + (lotW - wx) * hashUnit(p.seed, lot, 4);
+      const float z0 = float(k) * float(p.block) + half + (lotW - wz) * hashUnit(p.seed, lot, 5);
       // Taller near the plaza: up to maxHeight there, a third of it at the rim; storeys whole.
       const float fall = std::exp(-(r - float(p.plaza)) / (0.6f * float(p.radius - p.plaza)));
-      const float u = hashUnit(seed, lot, 6);
+      const float u = hashUnit(p.seed, lot, 6);
       const float hMax = float(p.maxHeight) * (0.3f + 0.7f * fall);
       const int storeys = std::max(1, int(hMax * (0.25f + 0.75f * u * u) / kFloorPitch));
-      const float h = float(storeys) * kFloorPitch;
-      boxes.push_back({x0, x0 + wx, z0, z0 + wz, h});
-      // Window slots on the four walls; a building's own share of lit windows varies.
-      const float litBias = hashUnit(seed, lot, 7);
-      const bool coolBuilding = hashUnit(seed, lot, 8) < p.coolShare;
-      uint32_t slot = 0;
-      for (int wall = 0; wall < 4; ++wall) {
-        const int n = wall < 2 ? 0 : 2;                           // walls facing x, then z
-        const float sign = (wall % 2) ? 1.0f : -1.0f;
-        const float len = n == 0 ? wz : wx;
-        const int cols = int((len - 0.008f) / kWindowPitch);
-        const float start = (n == 0 ? z0 : x0) + 0.5f * (len - float(cols - 1) * kWindowPitch);
-        for (int s = 0; s < storeys; ++s) {
-          for (int col = 0; col < cols; ++col, ++slot) {
-            float c[3];
-            c[1] = (float(s) + 0.55f) * kFloorPitch;
-            const float along = start + float(col) * kWindowPitch;
-            if (n == 0) {
-              c[0] = (sign > 0 ? x0 + wx : x0) + sign * kWindowGap;
-              c[2] = along;
-            } else {
-              c[0] = along;
-              c[2] = (sign > 0 ? z0 + wz : z0) + sign * kWindowGap;
-            }
-            const float key = hashUnit(seed, lot, 100 + slot) * (0.3f + 0.7f * litBias);
-            windows.push_back({axisQuad(c, n, sign, kWindowSize[0], kWindowSize[1]), key, coolBuilding});
-          }
-        }
-      }
+      city.boxes.push_back({x0, z0, wx, wz, storeys});
+      addWindows(city, city.boxes.back(), p.seed, lot, p.coolShare);
     }
   }
-  // Street lamps: along every street line within the radius, alternating sides.
+}
+
+// Street lamps: along every street line within the radius, every kLampPitch, alternating sides.
+void addLamps(City& city, const CityParams& p, int cells) {
+  const float half = 0.5f * float(p.street);
   for (int axis = 0; axis < 2; ++axis) {
     for (int line = -cells; line <= cells; ++line) {
       const float across = float(line) * float(p.block);
@@ -191,33 +205,44 @@ int runCity(const CityParams& p) {
         c[axis == 0 ? 2 : 0] = across + side;
         if (std::hypot(c[0], c[2]) > p.radius) continue;
         const uint32_t id = uint32_t(axis) * 1000000u + uint32_t(line + 1000) * 1000u + uint32_t(j + 500);
-        lamps.push_back({axisQuad(c, 1, -1.0f, kLampSize, kLampSize), hashUnit(seed, id, 9), false});
+        city.lamps.push_back({axisQuad(c, 1, -1.0f, kLampSize, kLampSize), hashUnit(p.seed, id, 9), false});
       }
     }
   }
+}
+
+// Keeps the n slots of smallest key (ties by position in the list), in their original order.
+void keepSmallest(std::vector<Slot>& slots, int n) {
+  std::vector<size_t> order(slots.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return slots[a].key < slots[b].key; });
+  std::vector<bool> keep(slots.size(), false);
+  for (int i = 0; i < n; ++i) keep[order[size_t(i)]] = true;
+  std::vector<Slot> out;
+  for (size_t i = 0; i < slots.size(); ++i)
+    if (keep[i]) out.push_back(slots[i]);
+  slots.swap(out);
+}
+
+}  // namespace
+
+int runCity(const CityParams& p) {
+  checkParams(p);
+  City city;
+  const int cells = int(std::ceil(p.radius / p.block)) + 1;
+  addBuildings(city, p, cells);
+  addLamps(city, p, cells);
   const int nLamps = int(std::lround(double(p.quads) * p.lampShare));
   const int nWindows = p.quads - nLamps;
-  if (size_t(nLamps) > lamps.size())
+  const size_t lampSlots = city.lamps.size(), windowSlots = city.windows.size();
+  if (size_t(nLamps) > lampSlots)
     throw std::runtime_error("city: " + std::to_string(nLamps) + " street lamps asked for, but the streets hold " +
-                             std::to_string(lamps.size()) + "; lower --quads or --lamp-share, or raise --radius");
-  if (size_t(nWindows) > windows.size())
+                             std::to_string(lampSlots) + "; lower --quads or --lamp-share, or raise --radius");
+  if (size_t(nWindows) > windowSlots)
     throw std::runtime_error("city: " + std::to_string(nWindows) + " lit windows asked for, but the buildings have " +
-                             std::to_string(windows.size()) + "; lower --quads or raise --lamp-share or --radius");
-  // Keep the n slots of smallest key (ties by position in the list), in their original order.
-  auto choose = [](std::vector<Slot>& slots, int n) {
-    std::vector<size_t> order(slots.size());
-    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return slots[a].key < slots[b].key; });
-    std::vector<bool> keep(slots.size(), false);
-    for (int i = 0; i < n; ++i) keep[order[size_t(i)]] = true;
-    std::vector<Slot> out;
-    for (size_t i = 0; i < slots.size(); ++i)
-      if (keep[i]) out.push_back(slots[i]);
-    slots.swap(out);
-  };
-  const size_t lampSlots = lamps.size(), windowSlots = windows.size();
-  choose(lamps, nLamps);
-  choose(windows, nWindows);
+                             std::to_string(windowSlots) + "; lower --quads or raise --lamp-share or --radius");
+  keepSmallest(city.lamps, nLamps);
+  keepSmallest(city.windows, nWindows);
 
   const std::filesystem::path dir(p.out);
   std::filesystem::create_directories(dir);
@@ -227,20 +252,20 @@ int runCity(const CityParams& p) {
                 "--max-height %g --lamp-share %g --cool-share %g\n",
                 p.quads, p.seed, p.radius, p.plaza, p.block, p.street, p.maxHeight, p.lampShare, p.coolShare);
   ObjWriter bw((dir / "city_buildings.obj").string(), std::string(header) + "o buildings\n");
-  for (const auto& b : boxes) bw.box(b[0], b[1], b[2], b[3], b[4]);
+  for (const Box& b : city.boxes) bw.box(b.x0, b.x0 + b.wx, b.z0, b.z0 + b.wz, float(b.storeys) * kFloorPitch);
   bw.close();
   ObjWriter lw((dir / "city_lamps.obj").string(), std::string(header) + "o lamps\n");
-  for (const Slot& s : lamps) lw.quad(s.q);
+  for (const Slot& s : city.lamps) lw.quad(s.q);
   lw.close();
   ObjWriter ww((dir / "city_windows_warm.obj").string(), std::string(header) + "o windows_warm\n");
   ObjWriter wc((dir / "city_windows_cool.obj").string(), std::string(header) + "o windows_cool\n");
-  for (const Slot& s : windows) (s.cool ? wc : ww).quad(s.q);
+  for (const Slot& s : city.windows) (s.cool ? wc : ww).quad(s.q);
   ww.close();
   wc.close();
   std::printf("%s: %zu buildings (%d quads); %s: %d lamps (of %zu slots); %s: %d windows; %s: %d windows (of %zu "
               "slots); %d emissive quads\n",
-              bw.path.c_str(), boxes.size(), bw.faces, lw.path.c_str(), lw.faces, lampSlots, ww.path.c_str(), ww.faces,
-              wc.path.c_str(), wc.faces, windowSlots, lw.faces + ww.faces + wc.faces);
+              bw.path.c_str(), city.boxes.size(), bw.faces, lw.path.c_str(), lw.faces, lampSlots, ww.path.c_str(),
+              ww.faces, wc.path.c_str(), wc.faces, windowSlots, lw.faces + ww.faces + wc.faces);
   return 0;
 }
 
