@@ -71,9 +71,10 @@ Image renderGpuPt(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene&
   return tracer.readImage();
 }
 
-void expectPtMatchesReference(gpu::Context& ctx, gpu::ShaderCompiler& compiler, Scene s, openvdb::FloatGrid::Ptr grid,
-                              int gpuSpp, int refSpp, const std::string& name, const std::string& outputGroup,
-                              const std::string& feature) {
+ReferenceCheck expectPtMatchesReference(gpu::Context& ctx, gpu::ShaderCompiler& compiler, Scene s,
+                                        openvdb::FloatGrid::Ptr grid, int gpuSpp, int refSpp, const std::string& name,
+                                        const std::string& outputGroup, const std::string& feature,
+                                        float mustFailScale) {
   Scene refScene = s;
   refScene.render.spp = refSpp;
   refScene.render.seed = 4242;
@@ -86,8 +87,15 @@ void expectPtMatchesReference(gpu::Context& ctx, gpu::ShaderCompiler& compiler, 
   EXPECT_NE(info.variant.find(feature), std::string::npos) << info.variant;
   ReferenceCheckOptions options;
   options.outputGroup = outputGroup;
-  expectMatchesReference(gpu, ref, name, options);
+  const ReferenceCheck check = expectMatchesReference(gpu, ref, name, options);
   EXPECT_EQ(info.truncated, 0u) << name;
+  if (mustFailScale > 0.0f) {
+    Image scaled = gpu;
+    for (float& v : scaled.rgb) v *= mustFailScale;
+    for (float& v : scaled.var) v *= mustFailScale * mustFailScale;
+    EXPECT_FALSE(checkAgainstReference(scaled, ref, options).pass()) << name << ": the image times " << mustFailScale << " passes too";
+  }
+  return check;
 }
 
 }  // namespace plume::test

@@ -8,6 +8,7 @@
 #include "io/image.h"
 #include "media/bake.h"
 #include "scene/scene.h"
+#include "support/reference_check.h"
 
 #include <gtest/gtest.h>
 #include <openvdb/openvdb.h>
@@ -47,9 +48,11 @@ Image renderGpuPt(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene&
 // Renders `scene` with the GPU path tracer at gpuSpp and with the CPU reference at refSpp (seed
 // 4242) and expects them to agree (support/reference_check.h: per-pixel and aggregate z-tests,
 // outputs under `outputGroup`), with no truncation, in a shader variant whose name contains
-// `feature`.
-void expectPtMatchesReference(gpu::Context& ctx, gpu::ShaderCompiler& compiler, Scene scene,
-                              openvdb::FloatGrid::Ptr grid, int gpuSpp, int refSpp, const std::string& name,
-                              const std::string& outputGroup, const std::string& feature);
+// `feature`. `mustFailScale` > 0: the same check with the path tracer's image (and its variance)
+// scaled by it must fail, so the test is shown able to see such a bias. Returns the check.
+ReferenceCheck expectPtMatchesReference(gpu::Context& ctx, gpu::ShaderCompiler& compiler, Scene scene,
+                                        openvdb::FloatGrid::Ptr grid, int gpuSpp, int refSpp, const std::string& name,
+                                        const std::string& outputGroup, const std::string& feature,
+                                        float mustFailScale = 0.0f);
 
 }  // namespace plume::test

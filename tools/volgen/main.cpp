@@ -4,6 +4,7 @@
 //   plume-volgen procedural --out volumes/procedural
 //   plume-volgen sky --out volumes/sky/sky.exr
 //   plume-volgen mesh --out volumes/smoke/sphere.obj
+//   plume-volgen city --out volumes/city
 //   plume-volgen badinputs --out tests/bad_inputs
 //   plume-volgen preview FILE.vdb -o FILE.pgm
 #include "volgen.h"
@@ -69,6 +70,20 @@ int main(int argc, char** argv) {
   me->add_option("--rings", mesh.rings, "latitude bands")->capture_default_str();
   me->add_option("--segments", mesh.segments, "meridians")->capture_default_str();
   me->callback([&] { action = [&] { return runMesh(mesh); }; });
+
+  CityParams city;
+  auto* ci = app.add_subcommand("city", "the many-lights scene: a night city of emissive quads around the smoke (OBJ files)");
+  ci->add_option("--out", city.out, "output folder")->capture_default_str();
+  ci->add_option("--quads", city.quads, "emissive quads (street lamps + lit windows), exactly")->capture_default_str();
+  ci->add_option("--seed", city.seed, "layout and lighting seed")->capture_default_str();
+  ci->add_option("--radius", city.radius, "city radius around the origin, world units")->capture_default_str();
+  ci->add_option("--plaza", city.plaza, "radius left open around the smoke")->capture_default_str();
+  ci->add_option("--block", city.block, "street grid pitch")->capture_default_str();
+  ci->add_option("--street", city.street, "street width")->capture_default_str();
+  ci->add_option("--max-height", city.maxHeight, "height of the tallest buildings")->capture_default_str();
+  ci->add_option("--lamp-share", city.lampShare, "share of the quads that are street lamps")->capture_default_str();
+  ci->add_option("--cool-share", city.coolShare, "share of the buildings with cool window light")->capture_default_str();
+  ci->callback([&] { action = [&] { return runCity(city); }; });
 
   std::string badOut = "tests/bad_inputs";
   auto* bi = app.add_subcommand("badinputs", "broken VDB files for tests/bad_inputs");

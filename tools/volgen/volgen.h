@@ -87,6 +87,22 @@ struct MeshParams {
 };
 int runMesh(const MeshParams& p);
 
+// The many-lights scene's city of lamps around the smoke (city.cpp): buildings, street lamps and
+// lit windows as OBJ files in `out`, exactly `quads` emissive quads; deterministic in `seed`.
+struct CityParams {
+  std::string out = "volumes/city";
+  int quads = 4000;         // emissive quads: street lamps and lit windows together
+  uint32_t seed = 12;
+  double radius = 3.6;      // the city's extent around the origin, world units
+  double plaza = 0.7;       // open around the smoke's source
+  double block = 0.3;       // street grid pitch
+  double street = 0.09;     // street width
+  double maxHeight = 0.45;  // the tallest buildings (next to the plaza)
+  double lampShare = 0.25;  // of the quads, street lamps (the rest: windows)
+  double coolShare = 0.3;   // of the buildings, those with cool light
+};
+int runCity(const CityParams& p);
+
 int runProcedural(const std::string& outDir);
 int runBadInputs(const std::string& outDir);
 
