@@ -62,30 +62,61 @@ RsTail rs_tail_start(RsDomain D, vec3 shaded, inout RngState rng) {
   return RsTail(D.origin, 1u, w, rng.counter, vec3(1.0f), vec3(0.0f), shaded);
 }
 
-// Segment s.j of the walk and what its vertex adds; false when the walk ends there.
+// Segment s.j of the walk and what its vertex adds; false when the walk ends there. With
+// surfaces the segment ends at the nearer of the medium's collision and the first surface, a
+// vertex either way (the path tracer's rule): NEE at either, BSDF sampling at a surface (weight
+// f cos / pdf), and emitters reached by NEE only, as the reservoirs' paths.
 bool rs_tail_segment(inout RsTail s, inout RngState rng) {
   uint j = s.j;
+  float tMax = DDA_INF;
+#ifdef PLUME_HAS_SURFACES
+  BvhHit hit = bvh_closest(s.x, s.w, 0.0f, SURF_FAR);
+  if (hit.prim != BVH_NONE) tMax = hit.t;
+#endif
 #ifdef PLUME_HAS_EMISSION
   uint emitting = rs_emission_vertices();
   uint segments = frame.maxBounces + 1u;
   float t;
   vec3 emitted;
-  bool collided = vol_sample_collision_emitting(s.x, s.w, DDA_INF, rng, t, emitted);
+  bool collided = vol_sample_collision_emitting(s.x, s.w, tMax, rng, t, emitted);
   if (j > emitting) s.L += s.beta * (vec3(1.0f) - vtx_albedo(VERTEX_MEDIUM)) * emitted;
+#ifdef PLUME_HAS_SURFACES
+  if ((!collided && hit.prim == BVH_NONE) || j > frame.maxBounces) return false;
+#else
   if (!collided || j > frame.maxBounces) return false;
+#endif
 #else
   uint segments = frame.maxBounces;
   float t;
+#ifdef PLUME_HAS_SURFACES
+  bool collided = vol_sample_collision(s.x, s.w, tMax, rng, t);
+  if (!collided && hit.prim == BVH_NONE) return false;
+#else
   if (!vol_sample_collision(s.x, s.w, DDA_INF, rng, t)) return false;
 #endif
+#endif
+#ifdef PLUME_HAS_SURFACES
+  PathVertex vx;
+  if (collided) {
+    s.x += t * s.w;
+    s.beta *= vtx_albedo(VERTEX_MEDIUM);
+    vx = vtx_medium(s.x, s.w);
+  } else {
+    s.x += hit.t * s.w;
+    vx = vtx_surface(s.x, s.w, hit.prim, surf_shading_normal(hit.prim, vec2(hit.u, hit.v), surf_normal(hit.prim)));
+  }
+#else
   s.x += t * s.w;
   s.beta *= vtx_albedo(VERTEX_MEDIUM);
+  PathVertex vx = vtx_medium(s.x, s.w);
+#endif
   if (j > rsp.prefixVertices) {
     uvec4 h = rng_next4(rng);
     uint light;
     vec2 ls;
-    float pl = rs_sample_light(s.w, vec3(rng_to_float(h.x), rng_to_float(h.y), rng_to_float(h.z)), light, ls);
-    if (pl > 0.0f) s.L += s.beta * rs_light_term(VOL_CURRENT, VERTEX_MEDIUM, light, ls, s.x, s.w, true, rng) / pl;
+    uint prim;
+    float pl = rs_sample_light(vx, vec3(rng_to_float(h.x), rng_to_float(h.y), rng_to_float(h.z)), rng, light, ls, prim);
+    if (pl > 0.0f) s.L += s.beta * rs_light_term(VOL_CURRENT, vx, light, ls, prim, true, rng) / pl;
   }
   if (j == segments) return false;
   if (j >= frame.rrStartBounce) {
@@ -93,7 +124,16 @@ bool rs_tail_segment(inout RsTail s, inout RngState rng) {
     if (rng_float(rng) >= q) return false;
     s.beta /= q;
   }
+#ifdef PLUME_HAS_SURFACES
+  vec3 wNext;
+  float pdfDir;
+  s.beta *= vtx_at_sample(vx, rng_float2(rng), wNext, pdfDir);
+  if (!(pdfDir > 0.0f)) return false;
+  s.x = vtx_at_origin(vx, wNext);
+  s.w = wNext;
+#else
   s.w = vtx_sample(VERTEX_MEDIUM, s.w, rng_float2(rng));
+#endif
   s.j = j + 1u;
   return true;
 }
@@ -115,16 +155,33 @@ vec3 rs_shade(RsDomain D, uint pixelIndex, uint set, inout RngState rng) {
   RsReservoir r = rs_load(set, pixelIndex);
   vec3 L = vec3(0.0f);
   if (r.W > 0.0f) L += r.W * rs_path_contribution(D, set, pixelIndex, true, rng);
-#ifdef PLUME_HAS_ENV
+#if defined(PLUME_HAS_ENV) || defined(PLUME_HAS_EMITTERS)
+  // The camera ray's end: the environment where it escapes, an emitter's front side where it
+  // hits one (a surface blocks the environment); one-segment paths, which no candidate ends with.
   vec3 dir = rs_domain_dir(D, rng_float2(rng));
+#ifdef PLUME_HAS_SURFACES
+  BvhHit hit = bvh_closest(D.origin, dir, 0.0f, SURF_FAR);
+  if (hit.prim != BVH_NONE) {
+    L += surf_emitted(hit.prim, surf_normal(hit.prim), dir) * vol_residual_tr(D.origin, dir, hit.t, rng);
+  } else {
+    L += light_escaped(dir) * vol_residual_tr(D.origin, dir, DDA_INF, rng);
+  }
+#else
   L += light_escaped(dir) * vol_residual_tr(D.origin, dir, DDA_INF, rng);
+#endif
 #endif
 #ifdef PLUME_HAS_EMISSION
   // The medium's emission seen directly (paths of one vertex, which no candidate ends with),
   // gathered along a camera ray with ratio tracking's running transmittance (vol_emission_along:
-  // no collision is needed, so the whole ray counts). A self-lit fire is mostly this term; the
-  // reservoirs carry the light the fire and the lights scatter.
-  L += (vec3(1.0f) - vtx_albedo(VERTEX_MEDIUM)) * vol_emission_along(D.origin, rs_domain_dir(D, rng_float2(rng)), DDA_INF, rng);
+  // no collision is needed, so the whole ray counts, up to the first surface). A self-lit fire is
+  // mostly this term; the reservoirs carry the light the fire and the lights scatter.
+  vec3 dirE = rs_domain_dir(D, rng_float2(rng));
+  float tEnd = DDA_INF;
+#ifdef PLUME_HAS_SURFACES
+  BvhHit hitE = bvh_closest(D.origin, dirE, 0.0f, SURF_FAR);
+  if (hitE.prim != BVH_NONE) tEnd = hitE.t;
+#endif
+  L += (vec3(1.0f) - vtx_albedo(VERTEX_MEDIUM)) * vol_emission_along(D.origin, dirE, tEnd, rng);
 #endif
   return L;
 }
