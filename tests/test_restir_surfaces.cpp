@@ -1,6 +1,6 @@
 // Unbiased ReSTIR with surfaces (issue 12 deliverable 4; notes/restir.md "Surfaces"): surface
 // vertices in the reservoirs' paths, NEE and BSDF sampling at them, emissive triangles as light
-// samples, the shift that copies a surface vertex's direction (and fails where the copied ray's
+// samples and as hits (MIS), the shift that copies a surface vertex's direction (and fails where the copied ray's
 // first event is of the other kind). Tier d: per-pixel Z-test and aggregate z-test against the
 // CPU reference (which intersects with Embree itself), pairwise MIS and the generalised balance
 // heuristic, with spatial reuse over a radius wide enough that neighbours' paths cross the
@@ -67,7 +67,7 @@ void expectRestirMatchesReference(gpu::Context& ctx, gpu::ShaderCompiler& compil
 // (medium vertices after surface vertices), the sky by BSDF sampling at the ground.
 TEST_F(GpuRestirSurfaces, SmokeOverGroundMatchesReference) {
   expectRestirMatchesReference(ctx(), compiler(), test::smokeOverGroundScene(16, 3), test::makeNoiseGrid(32, 1.0 / 16, 3),
-                               256, 1024, "smoke_over_ground");
+                               256, 4096, "smoke_over_ground");
 }
 
 // An occluder between the sun and the smoke (surface visibility on shadow rays) and a glossy
@@ -78,9 +78,11 @@ TEST_F(GpuRestirSurfaces, OccluderAndGlossyConductorMatchReference) {
 }
 
 // Emissive quads as the only lights: points on the emitters as light samples (area measure,
-// cosine at the light, the alias table's choice), emitters seen directly by camera rays, a
-// back-facing quad that must stay dark.
+// cosine at the light, the alias table's choice) and emitters hit by sampled directions, combined
+// by MIS (dropping the hits' weight doubles the image: mean ratio 1.96); emitters seen directly by
+// camera rays; a back-facing quad that must stay dark. The low quad hangs 0.5 above the ground
+// (the path tracer's test has it at 2 cm, where these run counts resolve only a 5% bias).
 TEST_F(GpuRestirSurfaces, EmissiveQuadsAsTheOnlyLightsMatchReference) {
-  expectRestirMatchesReference(ctx(), compiler(), test::emissiveQuadsScene(16, 3), test::makeNoiseGrid(32, 1.0 / 16, 7),
-                               256, 8192, "emissive_quads");
+  expectRestirMatchesReference(ctx(), compiler(), test::emissiveQuadsScene(16, 3, 0.5f),
+                               test::makeNoiseGrid(32, 1.0 / 16, 7), 256, 4096, "emissive_quads");
 }

@@ -92,12 +92,40 @@ float rs_sample_light(PathVertex vx, vec3 u, inout RngState rng, out uint light,
   return pdf * light_pdf(l, rs_decode_dir(ls), vx.rayDir, frame.g);
 }
 
-#ifdef PLUME_HAS_EMISSION
+#if defined(PLUME_HAS_EMISSION) || defined(PLUME_HAS_EMITTERS)
+// A path may end in emission (the medium's, or an emissive surface hit by a sampled direction).
+#define RS_ENDS_IN_EMISSION 1
 // The most vertices of a path a reservoir holds that ends in emission: one more than the light
 // paths' min(max_bounces, K) (its last vertex only emits), at most RS_MAX_VERTICES. Longer
 // emitting paths are the tail's (restir/shade.glsl); one-vertex ones final shading's.
 uint rs_emission_vertices() {
   return min(min(frame.maxBounces + 1u, rsp.prefixVertices + 1u), RS_MAX_VERTICES);
+}
+#endif
+
+#ifdef PLUME_HAS_EMITTERS
+// The power heuristic (Veach's thesis, eq. 9.15) between the emitters' light samples and the
+// vertices' own direction sampling, which both reach a point on an emitter: its solid-angle
+// density as a light sample (the choice's entry, the triangle's area density, d² / cos at the
+// light, d from the ray's origin) against the direction's density pdfDir at the vertex. A path
+// that reaches an emitter is split into the two, f = w_light f + w_dir f, and each part is an
+// integrand of its own in the reservoirs (its weight evaluated in the domain that evaluates f).
+float rs_emitter_weight(float pdfThis, float pdfOther) {
+  return pdfThis > 0.0f ? pdfThis * pdfThis / (pdfThis * pdfThis + pdfOther * pdfOther) : 0.0f;
+}
+
+float rs_emitter_light_pdf(uint prim, float dist, float cosLight) {
+  return lightChoice[frame.lightCount].probability * surf_emitter_pdf(prim) * dist * dist / cosLight;
+}
+
+// The emission of a hit on triangle prim at distance t along w from a vertex whose direction
+// sampling has density pdfDir there (vtx_at_pdf), with its MIS weight: the direction-sampling
+// part of an emitter's light.
+vec3 rs_emitter_hit(float pdfDir, uint prim, vec3 w, float t) {
+  vec3 n = surf_normal(prim);
+  vec3 Le = surf_emitted(prim, n, w);
+  float pl = rs_emitter_light_pdf(prim, t, abs(dot(n, w)));
+  return Le * rs_emitter_weight(pdfDir, pl);
 }
 #endif
 
@@ -122,7 +150,8 @@ vec3 rs_light_term(uint v, PathVertex vx, uint light, vec2 ls, uint prim, bool u
     float reach = dist - surf_offset_length(p);  // stop short of the emitter's own triangle
     if (surf_occluded(o, w, reach)) return vec3(0.0f);
     vec3 scatter = vtx_at_scatter(vx, w);
-    return surf_emission(prim) * scatter * (cosLight / (dist * dist)) * rs_transmittance(v, o, w, reach, unbiased, rng);
+    float mis = rs_emitter_weight(rs_emitter_light_pdf(prim, dist, cosLight), vtx_at_pdf(vx, w));
+    return surf_emission(prim) * scatter * (mis * cosLight / (dist * dist)) * rs_transmittance(v, o, w, reach, unbiased, rng);
   }
   GpuLight l = lights[min(light, max(frame.lightCount, 1u) - 1u)];
 #else
@@ -214,6 +243,7 @@ vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool unbiased, 
   float t = h.t1;
   vec3 f = vec3(1.0f);
   PathVertex vx = vtx_medium(x, w);
+  PathVertex prev = vx;  // the vertex before vx (what sampled w)
   // A path ending in emission: its last vertex absorbs (sigma_a Le = sigma_t (1 - albedo) Le)
   // instead of scattering towards a light.
   bool emits = false;
@@ -226,6 +256,7 @@ vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool unbiased, 
 #ifdef PLUME_HAS_SURFACES
       f *= vtx_at_scatter(vx, b.xyz);
       x = vtx_at_origin(vx, b.xyz);
+      prev = vx;
 #else
       f *= vtx_scatter(VERTEX_MEDIUM, w, b.xyz);
 #endif
@@ -246,6 +277,9 @@ vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool unbiased, 
     x += t * w;
 #ifdef PLUME_HAS_SURFACES
     if (kind == VERTEX_SURFACE) {
+#ifdef PLUME_HAS_EMITTERS
+      if (h.light == RS_LIGHT_EMITTER_HIT && i == n) return f * tr * rs_emitter_hit(vtx_at_pdf(prev, w), hit.prim, w, t);
+#endif
       vec3 ng = surf_normal(hit.prim);
       vx = vtx_surface(x, w, hit.prim, surf_shading_normal(hit.prim, vec2(hit.u, hit.v), ng));
       f *= tr;

@@ -33,7 +33,7 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
   // At most K = rsp.prefixVertices (<= RS_MAX_VERTICES) vertices, none for max_bounces 0; longer
   // paths: rs_tail (shade.glsl).
   uint maxVertices = min(min(frame.maxBounces, rsp.prefixVertices), RS_MAX_VERTICES);  // scatter to a light
-#ifdef PLUME_HAS_EMISSION
+#ifdef RS_ENDS_IN_EMISSION
   uint walkVertices = rs_emission_vertices();  // one more vertex that only emits
 #else
   uint walkVertices = maxVertices;
@@ -68,6 +68,9 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
     float t1 = 0.0f;
     uint keep = 0u;  // vertices of this walk's selected candidate (0: none): copied when the walk ends
     uint kinds = 0u;  // this walk's vertex kinds so far (RsPathHead.kinds)
+#ifdef PLUME_HAS_SURFACES
+    PathVertex prev = vtx_medium(x, w);  // the vertex that sampled w (the camera's, first)
+#endif
     for (uint j = 1u; j <= walkVertices; ++j) {
       float t;
       float sigmaC;
@@ -88,6 +91,22 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
         f *= trSurface;
         vx = vtx_surface(x, w, hit.prim, surf_shading_normal(hit.prim, vec2(hit.u, hit.v), surf_normal(hit.prim)));
         kinds |= 1u << (j - 1u);
+#ifdef PLUME_HAS_EMITTERS
+        // The candidate ending with the emitter this direction hits (its direction-sampling
+        // part, rs_emitter_hit); a camera ray's hit is final shading's.
+        if (j >= 2u) {
+          float ph = rs_luminance(f * rs_emitter_hit(vtx_at_pdf(prev, w), hit.prim, w, t));
+          if (rs_update(r, invM * ph / pdf, ph, 0.0f, rng_float(rng))) {
+            head.lightSample = vec2(0.0f);
+            head.t1 = t1;
+            head.vertexCount = j;
+            head.light = RS_LIGHT_EMITTER_HIT;
+            head.uv = uv;
+            head.kinds = kinds;
+            keep = j;
+          }
+        }
+#endif
       } else {
 #else
       if (!vol_mean_sample(x, w, DDA_INF, rng_float(rng), t, sigmaC, tau)) break;
@@ -126,7 +145,7 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
       } else {
         walk[j - 2u] = vec4(w, t);
       }
-#ifdef PLUME_HAS_EMISSION
+#ifdef RS_ENDS_IN_EMISSION
       if (j > maxVertices) break;  // no scattering beyond max_bounces
 #endif
       uvec4 h = rng_next4(rng);
@@ -162,6 +181,7 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
       pdf *= pdfDir;
       f *= scatter;
       x = vtx_at_origin(vx, wNext);
+      prev = vx;
 #else
       vec3 wNext = vtx_sample(VERTEX_MEDIUM, w, rng_float2(rng));
       float phase = vtx_scatter(VERTEX_MEDIUM, w, wNext);

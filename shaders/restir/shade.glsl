@@ -36,6 +36,7 @@ struct RsTail {
   vec3 w;
   uint rngCounter;  // the shading stream's draws so far
   vec3 beta;
+  float pdfDir;  // with surfaces: the density of w at the vertex that sampled it (vtx_at_pdf)
   vec3 L;       // the tail's radiance so far
   vec3 shaded;  // final shading's other terms (rs_shade): the pixel's sample is shaded + L
 };
@@ -44,28 +45,30 @@ struct RsTail {
 RsTail rs_tail_load(uint pixelIndex) {
   uint s = rs_state_slot(pixelIndex);
   vec4 a = rsOutput[s], b = rsOutput[s + 1u];
-  return RsTail(a.xyz, floatBitsToUint(a.w), b.xyz, floatBitsToUint(b.w), rsOutput[s + 2u].xyz,
-                rsOutput[s + 3u].xyz, rsOutput[s + 4u].xyz);
+  vec4 c = rsOutput[s + 2u];
+  return RsTail(a.xyz, floatBitsToUint(a.w), b.xyz, floatBitsToUint(b.w), c.xyz, c.w, rsOutput[s + 3u].xyz,
+                rsOutput[s + 4u].xyz);
 }
 
 void rs_tail_store(uint pixelIndex, RsTail s) {
   uint i = rs_state_slot(pixelIndex);
   rsOutput[i] = vec4(s.x, uintBitsToFloat(s.j));
   rsOutput[i + 1u] = vec4(s.w, uintBitsToFloat(s.rngCounter));
-  rsOutput[i + 2u] = vec4(s.beta, 0.0f);
+  rsOutput[i + 2u] = vec4(s.beta, s.pdfDir);
   rsOutput[i + 3u] = vec4(s.L, 0.0f);
   rsOutput[i + 4u] = vec4(s.shaded, 0.0f);
 }
 
 RsTail rs_tail_start(RsDomain D, vec3 shaded, inout RngState rng) {
   vec3 w = rs_domain_dir(D, rng_float2(rng));  // its own sub-pixel position: pdf 1 on the pixel
-  return RsTail(D.origin, 1u, w, rng.counter, vec3(1.0f), vec3(0.0f), shaded);
+  return RsTail(D.origin, 1u, w, rng.counter, vec3(1.0f), 0.0f, vec3(0.0f), shaded);
 }
 
 // Segment s.j of the walk and what its vertex adds; false when the walk ends there. With
 // surfaces the segment ends at the nearer of the medium's collision and the first surface, a
 // vertex either way (the path tracer's rule): NEE at either, BSDF sampling at a surface (weight
-// f cos / pdf), and emitters reached by NEE only, as the reservoirs' paths.
+// f cos / pdf), and emitters reached both ways with the reservoirs' MIS weights
+// (rs_emitter_weight).
 bool rs_tail_segment(inout RsTail s, inout RngState rng) {
   uint j = s.j;
   float tMax = DDA_INF;
@@ -73,27 +76,32 @@ bool rs_tail_segment(inout RsTail s, inout RngState rng) {
   BvhHit hit = bvh_closest(s.x, s.w, 0.0f, SURF_FAR);
   if (hit.prim != BVH_NONE) tMax = hit.t;
 #endif
-#ifdef PLUME_HAS_EMISSION
+#ifdef RS_ENDS_IN_EMISSION
   uint emitting = rs_emission_vertices();
   uint segments = frame.maxBounces + 1u;
+#else
+  uint segments = frame.maxBounces;
+#endif
   float t;
+#ifdef PLUME_HAS_EMISSION
   vec3 emitted;
   bool collided = vol_sample_collision_emitting(s.x, s.w, tMax, rng, t, emitted);
   if (j > emitting) s.L += s.beta * (vec3(1.0f) - vtx_albedo(VERTEX_MEDIUM)) * emitted;
-#ifdef PLUME_HAS_SURFACES
-  if ((!collided && hit.prim == BVH_NONE) || j > frame.maxBounces) return false;
 #else
-  if (!collided || j > frame.maxBounces) return false;
-#endif
-#else
-  uint segments = frame.maxBounces;
-  float t;
-#ifdef PLUME_HAS_SURFACES
   bool collided = vol_sample_collision(s.x, s.w, tMax, rng, t);
+#endif
+#ifdef PLUME_HAS_EMITTERS
+  // An emitter hit by the direction sampled at vertex j - 1 (its MIS part; the reservoirs hold
+  // those of segments up to rs_emission_vertices).
+  if (!collided && hit.prim != BVH_NONE && j > emitting) s.L += s.beta * rs_emitter_hit(s.pdfDir, hit.prim, s.w, hit.t);
+#endif
+#ifdef PLUME_HAS_SURFACES
   if (!collided && hit.prim == BVH_NONE) return false;
 #else
-  if (!vol_sample_collision(s.x, s.w, DDA_INF, rng, t)) return false;
+  if (!collided) return false;
 #endif
+#ifdef RS_ENDS_IN_EMISSION
+  if (j > frame.maxBounces) return false;
 #endif
 #ifdef PLUME_HAS_SURFACES
   PathVertex vx;
@@ -129,6 +137,7 @@ bool rs_tail_segment(inout RsTail s, inout RngState rng) {
   float pdfDir;
   s.beta *= vtx_at_sample(vx, rng_float2(rng), wNext, pdfDir);
   if (!(pdfDir > 0.0f)) return false;
+  s.pdfDir = vtx_at_pdf(vx, wNext);
   s.x = vtx_at_origin(vx, wNext);
   s.w = wNext;
 #else

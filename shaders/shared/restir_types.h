@@ -42,6 +42,9 @@ const uint RS_CANDIDATE_VERTICES = 64u;
 // the candidates' running reservoir (1), the tail's walk (5, restir/shade.glsl RsTail).
 const uint RS_STATE_SLOTS = 5u;
 const uint RS_LIGHT_EMISSION = 0xFFFFFFFFu;  // RsPathHead.light of a path ending in emission
+// RsPathHead.light of a path whose last vertex is an emissive surface hit by the direction sampled
+// at the vertex before it (its emission weighted by MIS against the emitters' light samples)
+const uint RS_LIGHT_EMITTER_HIT = 0xFFFFFFFEu;
 
 const uint RS_MIS_PAIRWISE = 0u;  // pairwise MIS with confidence weights (default, O(k))
 const uint RS_MIS_GBH = 1u;       // generalised balance heuristic (O(k^2))

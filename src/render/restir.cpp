@@ -98,13 +98,14 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   }
   // Reservoirs hold paths of at most `prefix` vertices; a longer max_bounces adds the tail, a
   // path-traced estimate of the paths with more vertices, to final shading (restir/shade.glsl).
-  // In an emitting medium a reservoir's path may end with one more vertex that only emits
-  // (rs_emission_vertices: min(max_bounces, prefix) + 1, at most RS_MAX_VERTICES), and the tail
-  // also gathers the emission of longer paths.
+  // In an emitting medium, or with emissive surfaces (hit by a sampled direction), a reservoir's
+  // path may end with one more vertex that only emits (rs_emission_vertices: min(max_bounces,
+  // prefix) + 1, at most RS_MAX_VERTICES), and the tail also gathers the emission of longer paths.
+  const bool endsInEmission = features_.emission || features_.emitters;
   const int prefix = std::min(options_.prefix, std::max(1, scene.render.maxBounces));
   const int emitting = std::min({scene.render.maxBounces + 1, prefix + 1, int(shared::RS_MAX_VERTICES)});
-  const bool tail = scene.render.maxBounces > prefix || (features_.emission && scene.render.maxBounces + 1 > emitting);
-  const int vertices = features_.emission ? emitting : prefix;  // stored per path
+  const bool tail = scene.render.maxBounces > prefix || (endsInEmission && scene.render.maxBounces + 1 > emitting);
+  const int vertices = endsInEmission ? emitting : prefix;  // stored per path
   if (options_.neighbours > int(shared::RS_MAX_NEIGHBOURS)) {
     throw InputError(scene.path + strf(": render.restir_neighbours: at most %u", shared::RS_MAX_NEIGHBOURS));
   }
@@ -151,7 +152,7 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   // segments (one more in an emitting medium).
   if (tail) {
     tail_ = make("passes/restir_tail.comp", "restir tail", {});
-    const uint32_t segments = uint32_t(scene.render.maxBounces) + (features_.emission ? 1u : 0u);
+    const uint32_t segments = uint32_t(scene.render.maxBounces) + (endsInEmission ? 1u : 0u);
     tailDispatches_ = (segments + shared::RS_TAIL_SEGMENTS - 1) / shared::RS_TAIL_SEGMENTS;
   }
 
@@ -191,7 +192,7 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   params_.candidates = uint32_t(options_.candidates);
   params_.bounceStride = stride;
   params_.prefixVertices = uint32_t(prefix);
-  params_.walksPerDispatch = std::max(1u, shared::RS_CANDIDATE_VERTICES / uint32_t(features_.emission ? emitting : prefix));
+  params_.walksPerDispatch = std::max(1u, shared::RS_CANDIDATE_VERTICES / uint32_t(endsInEmission ? emitting : prefix));
   params_.pixelCount = uint32_t(pixels);
   // The scene's lights and, with emissive surfaces, one entry for a point on them.
   params_.lightCount = uint32_t(scene.lights.size()) + (surfaces_ && surfaces_->emitterCount() > 0 ? 1u : 0u);
