@@ -1,20 +1,16 @@
 // Unbiased ReSTIR with surfaces (issue 12 deliverable 4; notes/restir.md "Surfaces"): surface
 // vertices in the reservoirs' paths, NEE and BSDF sampling at them, emissive triangles as light
-// samples and as hits (MIS), the shift that copies a surface vertex's direction (and fails where the copied ray's
-// first event is of the other kind). Tier d: per-pixel Z-test and aggregate z-test against the
-// CPU reference (which intersects with Embree itself), pairwise MIS and the generalised balance
-// heuristic, with spatial reuse over a radius wide enough that neighbours' paths cross the
-// ground's, the occluder's and the conductor's silhouettes. Each GPU sample is one frame of an
-// independent run (support/extreme.h runRestirCase), so the variances are honest.
-#include "reference/reference.h"
-#include "render/restir.h"
-#include "support/extreme.h"
+// samples and as hits (MIS), the shift that copies a surface vertex's direction (and fails where
+// the copied ray's first event is of the other kind). Tier d: per-pixel Z-test and aggregate
+// z-test against the CPU reference (which intersects with Embree itself), pairwise MIS and the
+// generalised balance heuristic, with spatial reuse over a radius wide enough that neighbours'
+// paths cross the ground's, the occluder's and the conductor's silhouettes. Each GPU sample is one frame of an
+// independent run (support/restir_check.h), so the variances are honest. The tail past a short
+// prefix: test_restir_surfaces_slow.cpp.
 #include "support/gpu_fixture.h"
 #include "support/grids.h"
-#include "support/reference_check.h"
+#include "support/restir_check.h"
 #include "support/scenes.h"
-
-#include <cstdio>
 
 using namespace plume;
 
@@ -22,59 +18,21 @@ namespace {
 
 class GpuRestirSurfaces : public test::GpuTest {};
 
-Image reference(Scene s, openvdb::FloatGrid::Ptr grid, int spp) {
-  s.render.spp = spp;
-  s.render.seed = 4242;
-  ref::ReferenceOptions opt;
-  opt.progress = false;
-  return ref::renderReference(s, grid, opt);
-}
-
-RestirOptions spatialReuse(uint32_t mis) {
-  RestirOptions o;
-  o.rounds = 1;
-  o.radius = 4;
-  o.historyCap = 0;
-  o.mis = mis;
-  return o;
-}
-
-// ReSTIR (pairwise and GBH, `runs` independent runs each) against one reference of refSpp.
-void expectRestirMatchesReference(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& s,
-                                  openvdb::FloatGrid::Ptr grid, int runs, int refSpp, const std::string& name) {
-  const Image ref = reference(s, grid, refSpp);
-  test::ExtremeCase c;
-  c.name = name;
-  c.scene = s;
-  c.grid = grid;
-  for (const uint32_t mis : {shared::RS_MIS_PAIRWISE, shared::RS_MIS_GBH}) {
-    const std::string label = name + (mis == shared::RS_MIS_GBH ? "_gbh" : "_pairwise");
-    const test::EstimatorRun run = test::runRestirCase(ctx, compiler, c, runs, spatialReuse(mis));
-    test::ReferenceCheckOptions options;
-    options.imageMeanVariance = run.imageMeanVariance;
-    options.outputGroup = "restir_surfaces";
-    const test::ReferenceCheck check = test::expectMatchesReference(run.image, ref, label, options);
-    EXPECT_EQ(run.truncated, 0u) << label;
-    EXPECT_EQ(run.nonFinite, 0u) << label;
-    std::printf("[restir surfaces] %s: %s (%.1f s)\n", label.c_str(), check.summary().c_str(), run.seconds);
-  }
-}
-
 }  // namespace
 
 // Smoke over a diffuse ground under a sun and a sky: the smoke's shadow on the ground (shadow
 // rays through the medium from surface vertices), the ground's light bounced into the smoke
 // (medium vertices after surface vertices), the sky by BSDF sampling at the ground.
 TEST_F(GpuRestirSurfaces, SmokeOverGroundMatchesReference) {
-  expectRestirMatchesReference(ctx(), compiler(), test::smokeOverGroundScene(16, 3), test::makeNoiseGrid(32, 1.0 / 16, 3),
-                               256, 4096, "smoke_over_ground");
+  test::expectRestirMatchesReference(ctx(), compiler(), test::smokeOverGroundScene(16, 3),
+                                     test::makeNoiseGrid(32, 1.0 / 16, 3), 256, 4096, "smoke_over_ground");
 }
 
 // An occluder between the sun and the smoke (surface visibility on shadow rays) and a glossy
 // conductor (GGX sampling and evaluation at surface vertices).
 TEST_F(GpuRestirSurfaces, OccluderAndGlossyConductorMatchReference) {
-  expectRestirMatchesReference(ctx(), compiler(), test::occluderAndConductorScene(16, 3),
-                               test::makeNoiseGrid(32, 1.0 / 16, 5), 256, 1024, "occluder_and_conductor");
+  test::expectRestirMatchesReference(ctx(), compiler(), test::occluderAndConductorScene(16, 3),
+                                     test::makeNoiseGrid(32, 1.0 / 16, 5), 256, 1024, "occluder_and_conductor");
 }
 
 // Emissive quads as the only lights: points on the emitters as light samples (area measure,
@@ -83,8 +41,8 @@ TEST_F(GpuRestirSurfaces, OccluderAndGlossyConductorMatchReference) {
 // camera rays; a back-facing quad that must stay dark. The low quad hangs 0.5 above the ground
 // (the path tracer's test has it at 2 cm, where these run counts resolve only a 5% bias).
 TEST_F(GpuRestirSurfaces, EmissiveQuadsAsTheOnlyLightsMatchReference) {
-  expectRestirMatchesReference(ctx(), compiler(), test::emissiveQuadsScene(16, 3, 0.5f),
-                               test::makeNoiseGrid(32, 1.0 / 16, 7), 256, 4096, "emissive_quads");
+  test::expectRestirMatchesReference(ctx(), compiler(), test::emissiveQuadsScene(16, 3, 0.5f),
+                                     test::makeNoiseGrid(32, 1.0 / 16, 7), 256, 4096, "emissive_quads");
 }
 
 // A black quad in front of the left half of the smoke: spatial reuse must not bring the smoke's
@@ -97,5 +55,6 @@ TEST_F(GpuRestirSurfaces, ReuseDoesNotLeakLightAcrossAnOccludersEdge) {
   Surface quad = test::planeSurface({0.6f, 0.9f, 2.3f}, {0.0f, 0.0f, 1.0f}, {0.9f, 2.4f});
   quad.albedo = glm::vec3(0.0f);
   s.surfaces.push_back(quad);
-  expectRestirMatchesReference(ctx(), compiler(), s, test::makeNoiseGrid(32, 1.0 / 16, 3), 64, 256, "occluder_edge");
+  test::expectRestirMatchesReference(ctx(), compiler(), s, test::makeNoiseGrid(32, 1.0 / 16, 3), 64, 256,
+                                     "occluder_edge");
 }
