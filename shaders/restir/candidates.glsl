@@ -24,6 +24,20 @@
 #ifndef PLUME_RESTIR_CANDIDATES_GLSL
 #define PLUME_RESTIR_CANDIDATES_GLSL
 
+// The head of the path a candidate ending at vertex j of a walk stands for (vertices 2..j are the
+// walk's, copied when the walk ends).
+RsPathHead rs_candidate_head(uint uv, float t1, uint j, uint kinds, uint light, vec2 ls, uint prim) {
+  RsPathHead h;
+  h.lightSample = ls;
+  h.t1 = t1;
+  h.vertexCount = j;
+  h.light = light;
+  h.kinds = kinds;
+  h.uv = uv;
+  h.lightPrim = prim;
+  return h;
+}
+
 // Walks first .. first + rsp.walksPerDispatch - 1 (at most M - 1) of the pixel's M.
 void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
   RsDomain D = rs_current_domain(pixel);
@@ -97,12 +111,7 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
         if (j >= 2u) {
           float ph = rs_luminance(f * rs_emitter_hit(vtx_at_pdf(prev, w), hit.prim, w, t));
           if (rs_update(r, invM * ph / pdf, ph, 0.0f, rng_float(rng))) {
-            head.lightSample = vec2(0.0f);
-            head.t1 = t1;
-            head.vertexCount = j;
-            head.light = RS_LIGHT_EMITTER_HIT;
-            head.uv = uv;
-            head.kinds = kinds;
+            head = rs_candidate_head(uv, t1, j, kinds, RS_LIGHT_EMITTER_HIT, vec2(0.0f), 0u);
             keep = j;
           }
         }
@@ -125,12 +134,7 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
       if (j >= 2u) {  // the candidate ending with x_j's emission: sigma_a Le instead of scattering
         float ph = rs_luminance(fArrive * (vec3(1.0f) - vtx_albedo(VERTEX_MEDIUM)) * vol_emitted_radiance_world(VOL_CURRENT, x));
         if (rs_update(r, invM * ph / pdf, ph, 0.0f, rng_float(rng))) {
-          head.lightSample = vec2(0.0f);
-          head.t1 = t1;
-          head.vertexCount = j;
-          head.light = RS_LIGHT_EMISSION;
-          head.uv = uv;
-          head.kinds = kinds;
+          head = rs_candidate_head(uv, t1, j, kinds, RS_LIGHT_EMISSION, vec2(0.0f), 0u);
           keep = j;
         }
       }
@@ -157,13 +161,7 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
         float ph = rs_luminance(f * rs_light_term(VOL_CURRENT, vx, light, ls, prim, false, rng));
         float weight = invM * ph / (pdf * pl);
         if (rs_update(r, weight, ph, 0.0f, rng_to_float(h.w))) {
-          head.lightSample = ls;
-          head.t1 = t1;
-          head.vertexCount = j;
-          head.light = light;
-          head.uv = uv;
-          head.kinds = kinds;
-          head.lightPrim = prim;
+          head = rs_candidate_head(uv, t1, j, kinds, light, ls, prim);
           keep = j;
         }
       }
