@@ -22,37 +22,10 @@ namespace {
 
 class GpuSurfaceTest : public test::GpuTest {};
 
-Surface plane(glm::vec3 centre, glm::vec3 normal, glm::vec2 size) {
-  Surface s;
-  s.plane = SurfacePlane{centre, normal, size};
-  return s;
-}
+Scene groundScene(int size, int bounces) { return test::smokeOverGroundScene(size, bounces); }
 
 Surface emitter(glm::vec3 centre, glm::vec3 normal, glm::vec2 size, glm::vec3 radiance) {
-  Surface s = plane(centre, normal, size);
-  s.albedo = glm::vec3(0.0f);
-  s.emission = radiance;
-  return s;
-}
-
-// The noise cloud (about [0, 2]³) over a ground plane at y = 0, seen from the front.
-Scene groundScene(int size, int bounces) {
-  Scene s;
-  s.path = "surface-scene";
-  s.camera.base.position = {1.0f, 1.4f, 4.6f};
-  s.camera.base.lookAt = {1.0f, 0.7f, 1.0f};
-  s.camera.base.fovY = 40.0f;
-  s.camera.width = s.camera.height = size;
-  s.media.push_back(Medium{});
-  s.medium().densityScale = 3.0f;
-  s.medium().albedo = glm::vec3(0.9f);
-  s.medium().g = 0.3f;
-  s.lights = {test::sunLight({0.5f, 1.0f, 0.3f}, {3.0f, 2.8f, 2.5f}), test::skyLight({0.10f, 0.12f, 0.16f})};
-  Surface ground = plane({1.0f, 0.0f, 1.0f}, {0, 1, 0}, {8.0f, 8.0f});
-  ground.albedo = glm::vec3(0.6f, 0.5f, 0.4f);
-  s.surfaces.push_back(ground);
-  s.render.maxBounces = bounces;
-  return s;
+  return test::emitterSurface(centre, normal, size, radiance);
 }
 
 void renderAndCompare(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& s, openvdb::FloatGrid::Ptr grid,
@@ -124,27 +97,15 @@ TEST_F(GpuSurfaceTest, SmokeOverGroundMatchesReference) {
 
 // An occluding quad between the sun and the smoke, and a glossy conductor quad beside it.
 TEST_F(GpuSurfaceTest, OccluderAndGlossyConductorMatchReference) {
-  Scene s = groundScene(24, 4);
-  Surface occluder = plane({1.4f, 2.6f, 1.2f}, {0.2f, 1.0f, 0.1f}, {1.0f, 1.0f});
-  occluder.albedo = glm::vec3(0.3f);
-  Surface metal = plane({2.4f, 0.8f, 0.4f}, {-1.0f, 0.2f, 0.6f}, {1.2f, 1.4f});
-  metal.material = SurfaceMaterial::Conductor;
-  metal.roughness = 0.3f;
-  metal.f0 = glm::vec3(0.95f, 0.64f, 0.54f);
-  s.surfaces.push_back(occluder);
-  s.surfaces.push_back(metal);
-  renderAndCompare(ctx(), compiler(), s, test::makeNoiseGrid(32, 1.0 / 16, 5), 512, 1024, "occluder_and_conductor");
+  renderAndCompare(ctx(), compiler(), test::occluderAndConductorScene(24, 4), test::makeNoiseGrid(32, 1.0 / 16, 5), 512,
+                   1024, "occluder_and_conductor");
 }
 
 // Emissive quads as the only lights (light sampling by area in proportion to power, BSDF and
 // phase sampling hitting them, combined by MIS), with a back-facing one that must stay dark.
 TEST_F(GpuSurfaceTest, EmissiveQuadsAsTheOnlyLightsMatchReference) {
-  Scene s = groundScene(24, 3);
-  s.lights.clear();
-  s.surfaces.push_back(emitter({0.2f, 2.4f, 1.0f}, {0.3f, -1.0f, 0.0f}, {0.5f, 0.5f}, {12.0f, 9.0f, 6.0f}));
-  s.surfaces.push_back(emitter({1.8f, 2.2f, 0.6f}, {-0.2f, -1.0f, 0.3f}, {0.3f, 0.6f}, {4.0f, 6.0f, 12.0f}));
-  s.surfaces.push_back(emitter({1.0f, 0.02f, 2.6f}, {0.0f, -1.0f, 0.0f}, {0.6f, 0.6f}, {50.0f, 50.0f, 50.0f}));
-  renderAndCompare(ctx(), compiler(), s, test::makeNoiseGrid(32, 1.0 / 16, 7), 4096, 8192, "emissive_quads");
+  renderAndCompare(ctx(), compiler(), test::emissiveQuadsScene(24, 3), test::makeNoiseGrid(32, 1.0 / 16, 7), 4096, 8192,
+                   "emissive_quads");
 }
 
 // DESIGN §5: a scene without surfaces compiles no traversal (no BVH binding in its kernels) and

@@ -1,7 +1,8 @@
 // Resources of the ReSTIR passes (numbers in shared/bindings.h; src/render/restir.cpp binds
 // them): the volume with its mean field and the previous frame's volume (the same resources as
 // the current one for a still grid), which the target function of the temporal domain reads
-// (DESIGN §4.2 step 5); the scene with the light choice; ReSTIR's parameters and reservoirs.
+// (DESIGN §4.2 step 5); the scene with the light choice and, with PLUME_HAS_SURFACES, its
+// surfaces (at bindings shifted past ReSTIR's own); ReSTIR's parameters and reservoirs.
 #ifndef PLUME_RESTIR_BINDINGS_GLSL
 #define PLUME_RESTIR_BINDINGS_GLSL
 
@@ -13,6 +14,10 @@
 #include "../shared/restir_types.h"
 #include "../volume/bindings.glsl"
 #include "../scene/bindings.glsl"
+#ifdef PLUME_HAS_SURFACES
+#define PLUME_SURF_BINDING_SHIFT RS_SURF_BINDING_SHIFT
+#include "../surface/surfaces.glsl"
+#endif
 
 layout(std430, binding = BIND_RS_PARAMS) readonly buffer RestirParamBuffer { RestirParams rsp; };
 // Reservoir sets: [set * pixels + pixel].

@@ -52,27 +52,80 @@ float rs_luminance(vec3 c) { return (c.x + c.y + c.z) * (1.0f / 3.0f); }
 // rs_encode_dir of it, and every domain reconnects to the decoded direction (or, for a point
 // light or a delta sun, to the light itself).
 
-// Draws a light sample at a vertex for a path arriving along wIn: the light chosen with the
-// probabilities the host stored (lightChoice; render/restir.cpp), then light_sample_dir. Returns
-// the sample's pdf (the light's, at the stored direction, times the choice probability) or 0.
-float rs_sample_light(vec3 wIn, vec3 u, out uint light, out vec2 ls) {
+// Draws a light sample at vertex vx: the light chosen with the probabilities the host stored
+// (lightChoice; render/restir.cpp), then light_sample_dir (at a surface vertex a constant
+// environment's direction by the BSDF's own sampling, as the path tracer's NEE). With emissive
+// surfaces the choice's entry GpuFrame.lightCount is "a point on the emitters": a triangle from
+// their alias table and a uniform point in it (prim, barycentrics in ls; four more draws from
+// rng, at every call). Returns the sample's pdf (the light's, at the stored direction, or per unit
+// area on the emitters, times the choice probability) or 0.
+float rs_sample_light(PathVertex vx, vec3 u, inout RngState rng, out uint light, out vec2 ls, out uint prim) {
   uint n = rsp.lightCount;
   light = 0u;
+  prim = 0u;
   while (light + 1u < n && u.x >= lightChoice[light].cdf) ++light;
-  GpuLight l = lights[light];
   float pdf = lightChoice[light].probability;
   ls = vec2(0.0f);
+#ifdef PLUME_HAS_EMITTERS
+  uvec4 e = rng_next4(rng);
+  if (light == frame.lightCount) {
+    prim = surf_pick_emitter(vec2(rng_to_float(e.x), rng_to_float(e.y)));
+    ls = surf_uniform_barycentrics(vec2(rng_to_float(e.z), rng_to_float(e.w)));
+    return pdf * surf_emitter_pdf(prim);
+  }
+  GpuLight l = lights[min(light, max(frame.lightCount, 1u) - 1u)];  // (in range on every lane)
+#else
+  GpuLight l = lights[light];
+#endif
   if (!light_samples_direction(l)) return pdf;
-  ls = rs_encode_dir(light_sample_dir(l, vec3(0.0f), wIn, frame.g, u.yz));
-  return pdf * light_pdf(l, rs_decode_dir(ls), wIn, frame.g);
+#ifdef PLUME_HAS_SURFACES
+  if (vx.kind == VERTEX_SURFACE && l.type == LIGHT_ENVIRONMENT) {
+    vec3 w;
+    float pdfDir;
+    vtx_at_sample(vx, u.yz, w, pdfDir);
+    if (!(pdfDir > 0.0f)) return 0.0f;
+    ls = rs_encode_dir(w);
+    return pdf * vtx_at_pdf(vx, rs_decode_dir(ls));
+  }
+#endif
+  ls = rs_encode_dir(light_sample_dir(l, vec3(0.0f), vx.rayDir, frame.g, u.yz));
+  return pdf * light_pdf(l, rs_decode_dir(ls), vx.rayDir, frame.g);
 }
 
-#ifdef PLUME_HAS_EMISSION
+#if defined(PLUME_HAS_EMISSION) || defined(PLUME_HAS_EMITTERS)
+// A path may end in emission (the medium's, or an emissive surface hit by a sampled direction).
+#define RS_ENDS_IN_EMISSION 1
 // The most vertices of a path a reservoir holds that ends in emission: one more than the light
 // paths' min(max_bounces, K) (its last vertex only emits), at most RS_MAX_VERTICES. Longer
 // emitting paths are the tail's (restir/shade.glsl); one-vertex ones final shading's.
 uint rs_emission_vertices() {
   return min(min(frame.maxBounces + 1u, rsp.prefixVertices + 1u), RS_MAX_VERTICES);
+}
+#endif
+
+#ifdef PLUME_HAS_EMITTERS
+// The power heuristic (Veach's thesis, eq. 9.15) between the emitters' light samples and the
+// vertices' own direction sampling, which both reach a point on an emitter: its solid-angle
+// density as a light sample (the choice's entry, the triangle's area density, d² / cos at the
+// light, d from the ray's origin) against the direction's density pdfDir at the vertex. A path
+// that reaches an emitter is split into the two, f = w_light f + w_dir f, and each part is an
+// integrand of its own in the reservoirs (its weight evaluated in the domain that evaluates f).
+float rs_emitter_weight(float pdfThis, float pdfOther) {
+  return pdfThis > 0.0f ? pdfThis * pdfThis / (pdfThis * pdfThis + pdfOther * pdfOther) : 0.0f;
+}
+
+float rs_emitter_light_pdf(uint prim, float dist, float cosLight) {
+  return lightChoice[frame.lightCount].probability * surf_emitter_pdf(prim) * dist * dist / cosLight;
+}
+
+// The emission of a hit on triangle prim at distance t along w from a vertex whose direction
+// sampling has density pdfDir there (vtx_at_pdf), with its MIS weight: the direction-sampling
+// part of an emitter's light.
+vec3 rs_emitter_hit(float pdfDir, uint prim, vec3 w, float t) {
+  vec3 n = surf_normal(prim);
+  vec3 Le = surf_emitted(prim, n, w);
+  float pl = rs_emitter_light_pdf(prim, t, abs(dot(n, w)));
+  return Le * rs_emitter_weight(pdfDir, pl);
 }
 #endif
 
@@ -82,14 +135,39 @@ float rs_transmittance(uint v, vec3 x, vec3 w, float dist, bool unbiased, inout 
   return unbiased ? vol_residual_tr(x, w, dist, rng) : vol_mean_tr(v, x, w, dist);
 }
 
-// The light term at the path's last vertex x (kind `kind`, path arriving along wIn): Le * scatter * T.
-vec3 rs_light_term(uint v, uint kind, uint light, vec2 ls, vec3 x, vec3 wIn, bool unbiased, inout RngState rng) {
+// The light term at the path's last vertex vx: Le * scatter * T (times surface visibility; for a
+// point on an emissive triangle, per unit area: Le * scatter * cos_light / d² * T * V).
+vec3 rs_light_term(uint v, PathVertex vx, uint light, vec2 ls, uint prim, bool unbiased, inout RngState rng) {
+#ifdef PLUME_HAS_EMITTERS
+  if (light == frame.lightCount) {
+    vec3 p = surf_triangle_point(prim, ls);
+    vec3 o = vtx_at_origin(vx, p - vx.x);
+    vec3 toL = p - o;
+    float dist = length(toL);
+    vec3 w = toL / dist;
+    float cosLight = -dot(surf_normal(prim), w);  // the back side emits nothing
+    if (!(dist > 0.0f) || !(cosLight > 0.0f)) return vec3(0.0f);
+    float reach = dist - surf_offset_length(p);  // stop short of the emitter's own triangle
+    if (surf_occluded(o, w, reach)) return vec3(0.0f);
+    vec3 scatter = vtx_at_scatter(vx, w);
+    float mis = rs_emitter_weight(rs_emitter_light_pdf(prim, dist, cosLight), vtx_at_pdf(vx, w));
+    return surf_emission(prim) * scatter * (mis * cosLight / (dist * dist)) * rs_transmittance(v, o, w, reach, unbiased, rng);
+  }
+  GpuLight l = lights[min(light, max(frame.lightCount, 1u) - 1u)];
+#else
   GpuLight l = lights[light];
+#endif
   vec3 w;
   float dist;
   vec3 Le;
-  if (!light_connect(l, x, rs_decode_dir(ls), w, dist, Le)) return vec3(0.0f);
-  return Le * vtx_scatter(kind, w, wIn) * rs_transmittance(v, x, w, dist, unbiased, rng);
+  if (!light_connect(l, vx.x, rs_decode_dir(ls), w, dist, Le)) return vec3(0.0f);
+#ifdef PLUME_HAS_SURFACES
+  vec3 o = vtx_at_origin(vx, w);
+  if (surf_occluded(o, w, dist)) return vec3(0.0f);
+  return Le * vtx_at_scatter(vx, w) * rs_transmittance(v, o, w, dist, unbiased, rng);
+#else
+  return Le * vtx_scatter(VERTEX_MEDIUM, w, vx.rayDir) * rs_transmittance(v, vx.x, w, dist, unbiased, rng);
+#endif
 }
 
 // --- Path storage --------------------------------------------------------------------------------
@@ -116,14 +194,14 @@ RsPathHead rs_load_head(uint set, uint pixelIndex) {
   h.light = b.x;
   h.kinds = b.y;
   h.uv = b.z;
-  h.pad0 = b.w;
+  h.lightPrim = b.w;
   return h;
 }
 
 void rs_store_head(uint set, uint pixelIndex, RsPathHead h) {
   uint i = 2u * rs_slot(set, pixelIndex);
   rsPathWords[i] = uvec4(floatBitsToUint(h.lightSample), floatBitsToUint(h.t1), h.vertexCount);
-  rsPathWords[i + 1u] = uvec4(h.light, h.kinds, h.uv, h.pad0);
+  rsPathWords[i + 1u] = uvec4(h.light, h.kinds, h.uv, h.lightPrim);
 }
 
 // A pixel's state between the dispatches of one pass (RS_STATE_SLOTS vec4s past the
@@ -147,11 +225,14 @@ void rs_copy_path(uint srcSet, uint srcPixel, uint dstSet, uint dstPixel) {
 }
 
 // --- The path contribution f_D(y) ----------------------------------------------------------------
-// y is the path stored at (set, pixel); D any domain. Vertices x_1 = o + t1 d(u, v), x_i = x_{i-1} +
-// t_i w_i; f = prod_i [T(x_{i-1}, x_i) sigma_s(x_i)] * prod_{i>=2} scatter(w_{i-1}, w_i) * light
-// term, RGB, times the shift's Jacobian at each vertex (integrator/vertex.glsl: 1 for media). A
-// vertex with zero density (or outside the volume) makes f = 0: the shift fails. A path ending in
-// emission has sigma_a(x_n) Le(x_n) in place of sigma_s(x_n) and the light term.
+// y is the path stored at (set, pixel); D any domain. Vertices x_1 = o + t1 d(u, v), x_i = o_{i-1} +
+// t_i w_i (o_i: x_i, pushed off a surface towards w_{i+1}); f = prod_i [T(o_{i-1}, x_i) v(x_i)] *
+// prod_{i>=2} scatter(x_{i-1}, w_i) * light term, RGB, with v = sigma_s at a medium vertex and 1 at
+// a surface vertex, whose place is the first surface hit along w_i (t_i is implied) and whose
+// scatter is BSDF x cos (integrator/vertex.glsl); the shift's Jacobian is 1 at either kind. The
+// shift fails (f = 0) where the copied path cannot exist in D: a medium vertex with zero density
+// (or outside the volume) or behind a surface, a surface vertex whose ray meets no surface. A
+// path ending in emission has sigma_a(x_n) Le(x_n) in place of sigma_s(x_n) and the light term.
 vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool unbiased, inout RngState rng) {
   RsPathHead h = rs_load_head(set, pixelIndex);
   uint n = h.vertexCount;
@@ -161,7 +242,8 @@ vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool unbiased, 
   vec3 w = rs_domain_dir(D, rs_unpack_uv(h.uv));
   float t = h.t1;
   vec3 f = vec3(1.0f);
-  uint kind = VERTEX_MEDIUM;
+  PathVertex vx = vtx_medium(x, w);
+  PathVertex prev = vx;  // the vertex before vx (what sampled w)
   // A path ending in emission: its last vertex absorbs (sigma_a Le = sigma_t (1 - albedo) Le)
   // instead of scattering towards a light.
   bool emits = false;
@@ -171,13 +253,40 @@ vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool unbiased, 
   for (uint i = 1u; i <= n; ++i) {
     if (i >= 2u) {
       vec4 b = rsBounces[base + i - 2u];
-      f *= vtx_scatter(kind, w, b.xyz);
+#ifdef PLUME_HAS_SURFACES
+      f *= vtx_at_scatter(vx, b.xyz);
+      x = vtx_at_origin(vx, b.xyz);
+      prev = vx;
+#else
+      f *= vtx_scatter(VERTEX_MEDIUM, w, b.xyz);
+#endif
       w = b.xyz;
       t = b.w;
     }
-    kind = vtx_kind(h.kinds, i);
+    uint kind = vtx_kind(h.kinds, i);
+#ifdef PLUME_HAS_SURFACES
+    BvhHit hit = bvh_closest(x, w, 0.0f, SURF_FAR);
+    if (kind == VERTEX_SURFACE) {
+      if (hit.prim == BVH_NONE) return vec3(0.0f);
+      t = hit.t;
+    } else if (hit.prim != BVH_NONE && !(t < hit.t)) {
+      return vec3(0.0f);
+    }
+#endif
     float tr = rs_transmittance(D.v, x, w, t, unbiased, rng);
     x += t * w;
+#ifdef PLUME_HAS_SURFACES
+    if (kind == VERTEX_SURFACE) {
+#ifdef PLUME_HAS_EMITTERS
+      if (h.light == RS_LIGHT_EMITTER_HIT && i == n) return f * tr * rs_emitter_hit(vtx_at_pdf(prev, w), hit.prim, w, t);
+#endif
+      vec3 ng = surf_normal(hit.prim);
+      vx = vtx_surface(x, w, hit.prim, surf_shading_normal(hit.prim, vec2(hit.u, hit.v), ng));
+      f *= tr;
+      continue;
+    }
+    vx = vtx_medium(x, w);
+#endif
     float sigma = vol_sigma_t_world(D.v, x);
     if (!(sigma > 0.0f)) return vec3(0.0f);
     vec3 a = vtx_albedo(kind);
@@ -187,7 +296,10 @@ vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool unbiased, 
 #ifdef PLUME_HAS_EMISSION
   if (emits) return f * vol_emitted_radiance_world(D.v, x);
 #endif
-  return f * rs_light_term(D.v, kind, h.light, h.lightSample, x, w, unbiased, rng);
+#ifndef PLUME_HAS_SURFACES
+  vx = vtx_medium(x, w);
+#endif
+  return f * rs_light_term(D.v, vx, h.light, h.lightSample, h.lightPrim, unbiased, rng);
 }
 
 // The target function p̂_D(y): deterministic (no random numbers are drawn on this path).

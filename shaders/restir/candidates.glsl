@@ -24,6 +24,20 @@
 #ifndef PLUME_RESTIR_CANDIDATES_GLSL
 #define PLUME_RESTIR_CANDIDATES_GLSL
 
+// The head of the path a candidate ending at vertex j of a walk stands for (vertices 2..j are the
+// walk's, copied when the walk ends).
+RsPathHead rs_candidate_head(uint uv, float t1, uint j, uint kinds, uint light, vec2 ls, uint prim) {
+  RsPathHead h;
+  h.lightSample = ls;
+  h.t1 = t1;
+  h.vertexCount = j;
+  h.light = light;
+  h.kinds = kinds;
+  h.uv = uv;
+  h.lightPrim = prim;
+  return h;
+}
+
 // Walks first .. first + rsp.walksPerDispatch - 1 (at most M - 1) of the pixel's M.
 void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
   RsDomain D = rs_current_domain(pixel);
@@ -33,7 +47,7 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
   // At most K = rsp.prefixVertices (<= RS_MAX_VERTICES) vertices, none for max_bounces 0; longer
   // paths: rs_tail (shade.glsl).
   uint maxVertices = min(min(frame.maxBounces, rsp.prefixVertices), RS_MAX_VERTICES);  // scatter to a light
-#ifdef PLUME_HAS_EMISSION
+#ifdef RS_ENDS_IN_EMISSION
   uint walkVertices = rs_emission_vertices();  // one more vertex that only emits
 #else
   uint walkVertices = maxVertices;
@@ -49,7 +63,7 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
     head.light = 0u;
     head.kinds = 0u;
     head.uv = 0u;
-    head.pad0 = 0u;
+    head.lightPrim = 0u;
   } else {  // the walks before this one
     vec4 state = rsOutput[rs_state_slot(pixelIndex)];
     r.w_sum = state.x;
@@ -67,11 +81,45 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
     float pdf = 1.0f;     // prefix of the source pdf
     float t1 = 0.0f;
     uint keep = 0u;  // vertices of this walk's selected candidate (0: none): copied when the walk ends
+    uint kinds = 0u;  // this walk's vertex kinds so far (RsPathHead.kinds)
+#ifdef PLUME_HAS_SURFACES
+    PathVertex prev = vtx_medium(x, w);  // the vertex that sampled w (the camera's, first)
+#endif
     for (uint j = 1u; j <= walkVertices; ++j) {
       float t;
       float sigmaC;
       float tau;
+#ifdef PLUME_HAS_SURFACES
+      // The nearer of the mean field's collision and the first surface: the surface is reached
+      // with the probability of passing the mean field up to it, exp(-tau_c(0, t_hit)).
+      BvhHit hit = bvh_closest(x, w, 0.0f, SURF_FAR);
+      float tMax = hit.prim != BVH_NONE ? hit.t : DDA_INF;
+      bool collided = vol_mean_sample(x, w, tMax, rng_float(rng), t, sigmaC, tau);
+      PathVertex vx;
+      if (!collided) {
+        if (hit.prim == BVH_NONE) break;
+        float trSurface = exp(-min(vol_mean_tau(VOL_CURRENT, x, w, hit.t), VOL_MAX_TAU));
+        t = hit.t;
+        x += t * w;
+        pdf *= trSurface;
+        f *= trSurface;
+        vx = vtx_surface(x, w, hit.prim, surf_shading_normal(hit.prim, vec2(hit.u, hit.v), surf_normal(hit.prim)));
+        kinds |= 1u << (j - 1u);
+#ifdef PLUME_HAS_EMITTERS
+        // The candidate ending with the emitter this direction hits (its direction-sampling
+        // part, rs_emitter_hit); a camera ray's hit is final shading's.
+        if (j >= 2u) {
+          float ph = rs_luminance(f * rs_emitter_hit(vtx_at_pdf(prev, w), hit.prim, w, t));
+          if (rs_update(r, invM * ph / pdf, ph, 0.0f, rng_float(rng))) {
+            head = rs_candidate_head(uv, t1, j, kinds, RS_LIGHT_EMITTER_HIT, vec2(0.0f), 0u);
+            keep = j;
+          }
+        }
+#endif
+      } else {
+#else
       if (!vol_mean_sample(x, w, DDA_INF, rng_float(rng), t, sigmaC, tau)) break;
+#endif
       float trTarget = exp(-min(tau, VOL_MAX_TAU));  // the target's transmittance (same field)
       x += t * w;
       float sigma = vol_sigma_t_world(VOL_CURRENT, x);
@@ -81,38 +129,41 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
       pdf *= sigmaC * exp(-tau);   // the sampling field's free-flight pdf
       vec3 fArrive = f * trTarget * sigma;  // before x_j scatters or absorbs
       f = fArrive * vtx_albedo(VERTEX_MEDIUM);
+#ifdef PLUME_HAS_SURFACES
+      vx = vtx_medium(x, w);
+#endif
+  #ifdef PLUME_HAS_EMISSION
+      if (j >= 2u) {  // the candidate ending with x_j's emission: sigma_a Le instead of scattering
+        float ph = rs_luminance(fArrive * (vec3(1.0f) - vtx_albedo(VERTEX_MEDIUM)) * vol_emitted_radiance_world(VOL_CURRENT, x));
+        if (rs_update(r, invM * ph / pdf, ph, 0.0f, rng_float(rng))) {
+          head = rs_candidate_head(uv, t1, j, kinds, RS_LIGHT_EMISSION, vec2(0.0f), 0u);
+          keep = j;
+        }
+      }
+  #endif
+#ifdef PLUME_HAS_SURFACES
+      }
+#else
+      PathVertex vx = vtx_medium(x, w);
+#endif
       if (j == 1u) {
         t1 = t;
       } else {
         walk[j - 2u] = vec4(w, t);
       }
-  #ifdef PLUME_HAS_EMISSION
-      if (j >= 2u) {  // the candidate ending with x_j's emission: sigma_a Le instead of scattering
-        float ph = rs_luminance(fArrive * (vec3(1.0f) - vtx_albedo(VERTEX_MEDIUM)) * vol_emitted_radiance_world(VOL_CURRENT, x));
-        if (rs_update(r, invM * ph / pdf, ph, 0.0f, rng_float(rng))) {
-          head.lightSample = vec2(0.0f);
-          head.t1 = t1;
-          head.vertexCount = j;
-          head.light = RS_LIGHT_EMISSION;
-          head.uv = uv;
-          keep = j;
-        }
-      }
+#ifdef RS_ENDS_IN_EMISSION
       if (j > maxVertices) break;  // no scattering beyond max_bounces
-  #endif
+#endif
       uvec4 h = rng_next4(rng);
       uint light;
       vec2 ls;
-      float pl = rs_sample_light(w, vec3(rng_to_float(h.x), rng_to_float(h.y), rng_to_float(h.z)), light, ls);
+      uint prim;
+      float pl = rs_sample_light(vx, vec3(rng_to_float(h.x), rng_to_float(h.y), rng_to_float(h.z)), rng, light, ls, prim);
       if (pl > 0.0f) {
-        float ph = rs_luminance(f * rs_light_term(VOL_CURRENT, VERTEX_MEDIUM, light, ls, x, w, false, rng));
+        float ph = rs_luminance(f * rs_light_term(VOL_CURRENT, vx, light, ls, prim, false, rng));
         float weight = invM * ph / (pdf * pl);
         if (rs_update(r, weight, ph, 0.0f, rng_to_float(h.w))) {
-          head.lightSample = ls;
-          head.t1 = t1;
-          head.vertexCount = j;
-          head.light = light;
-          head.uv = uv;
+          head = rs_candidate_head(uv, t1, j, kinds, light, ls, prim);
           keep = j;
         }
       }
@@ -121,10 +172,22 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
         if (rng_float(rng) >= q) break;
         pdf *= q;
       }
+#ifdef PLUME_HAS_SURFACES
+      vec3 wNext;
+      float pdfDir;
+      vtx_at_sample(vx, rng_float2(rng), wNext, pdfDir);
+      if (!(pdfDir > 0.0f)) break;  // (a BSDF that produced no direction)
+      vec3 scatter = vtx_at_scatter(vx, wNext);
+      pdf *= pdfDir;
+      f *= scatter;
+      x = vtx_at_origin(vx, wNext);
+      prev = vx;
+#else
       vec3 wNext = vtx_sample(VERTEX_MEDIUM, w, rng_float2(rng));
       float phase = vtx_scatter(VERTEX_MEDIUM, w, wNext);
       pdf *= phase;
       f *= phase;
+#endif
       w = wNext;
     }
     for (uint i = 0u; i + 2u <= keep; ++i) rsBounces[base + i] = walk[i];

@@ -36,6 +36,7 @@ struct RsTail {
   vec3 w;
   uint rngCounter;  // the shading stream's draws so far
   vec3 beta;
+  float pdfDir;  // with surfaces: the density of w at the vertex that sampled it (vtx_at_pdf)
   vec3 L;       // the tail's radiance so far
   vec3 shaded;  // final shading's other terms (rs_shade): the pixel's sample is shaded + L
 };
@@ -44,48 +45,86 @@ struct RsTail {
 RsTail rs_tail_load(uint pixelIndex) {
   uint s = rs_state_slot(pixelIndex);
   vec4 a = rsOutput[s], b = rsOutput[s + 1u];
-  return RsTail(a.xyz, floatBitsToUint(a.w), b.xyz, floatBitsToUint(b.w), rsOutput[s + 2u].xyz,
-                rsOutput[s + 3u].xyz, rsOutput[s + 4u].xyz);
+  vec4 c = rsOutput[s + 2u];
+  return RsTail(a.xyz, floatBitsToUint(a.w), b.xyz, floatBitsToUint(b.w), c.xyz, c.w, rsOutput[s + 3u].xyz,
+                rsOutput[s + 4u].xyz);
 }
 
 void rs_tail_store(uint pixelIndex, RsTail s) {
   uint i = rs_state_slot(pixelIndex);
   rsOutput[i] = vec4(s.x, uintBitsToFloat(s.j));
   rsOutput[i + 1u] = vec4(s.w, uintBitsToFloat(s.rngCounter));
-  rsOutput[i + 2u] = vec4(s.beta, 0.0f);
+  rsOutput[i + 2u] = vec4(s.beta, s.pdfDir);
   rsOutput[i + 3u] = vec4(s.L, 0.0f);
   rsOutput[i + 4u] = vec4(s.shaded, 0.0f);
 }
 
 RsTail rs_tail_start(RsDomain D, vec3 shaded, inout RngState rng) {
   vec3 w = rs_domain_dir(D, rng_float2(rng));  // its own sub-pixel position: pdf 1 on the pixel
-  return RsTail(D.origin, 1u, w, rng.counter, vec3(1.0f), vec3(0.0f), shaded);
+  return RsTail(D.origin, 1u, w, rng.counter, vec3(1.0f), 0.0f, vec3(0.0f), shaded);
 }
 
-// Segment s.j of the walk and what its vertex adds; false when the walk ends there.
+// Segment s.j of the walk and what its vertex adds; false when the walk ends there. With
+// surfaces the segment ends at the nearer of the medium's collision and the first surface, a
+// vertex either way (the path tracer's rule): NEE at either, BSDF sampling at a surface (weight
+// f cos / pdf), and emitters reached both ways with the reservoirs' MIS weights
+// (rs_emitter_weight).
 bool rs_tail_segment(inout RsTail s, inout RngState rng) {
   uint j = s.j;
-#ifdef PLUME_HAS_EMISSION
+  float tMax = DDA_INF;
+#ifdef PLUME_HAS_SURFACES
+  BvhHit hit = bvh_closest(s.x, s.w, 0.0f, SURF_FAR);
+  if (hit.prim != BVH_NONE) tMax = hit.t;
+#endif
+#ifdef RS_ENDS_IN_EMISSION
   uint emitting = rs_emission_vertices();
   uint segments = frame.maxBounces + 1u;
-  float t;
-  vec3 emitted;
-  bool collided = vol_sample_collision_emitting(s.x, s.w, DDA_INF, rng, t, emitted);
-  if (j > emitting) s.L += s.beta * (vec3(1.0f) - vtx_albedo(VERTEX_MEDIUM)) * emitted;
-  if (!collided || j > frame.maxBounces) return false;
 #else
   uint segments = frame.maxBounces;
-  float t;
-  if (!vol_sample_collision(s.x, s.w, DDA_INF, rng, t)) return false;
 #endif
+  float t;
+#ifdef PLUME_HAS_EMISSION
+  vec3 emitted;
+  bool collided = vol_sample_collision_emitting(s.x, s.w, tMax, rng, t, emitted);
+  if (j > emitting) s.L += s.beta * (vec3(1.0f) - vtx_albedo(VERTEX_MEDIUM)) * emitted;
+#else
+  bool collided = vol_sample_collision(s.x, s.w, tMax, rng, t);
+#endif
+#ifdef PLUME_HAS_EMITTERS
+  // An emitter hit by the direction sampled at vertex j - 1 (its MIS part; the reservoirs hold
+  // those of segments up to rs_emission_vertices).
+  if (!collided && hit.prim != BVH_NONE && j > emitting) s.L += s.beta * rs_emitter_hit(s.pdfDir, hit.prim, s.w, hit.t);
+#endif
+#ifdef PLUME_HAS_SURFACES
+  if (!collided && hit.prim == BVH_NONE) return false;
+#else
+  if (!collided) return false;
+#endif
+#ifdef RS_ENDS_IN_EMISSION
+  if (j > frame.maxBounces) return false;
+#endif
+#ifdef PLUME_HAS_SURFACES
+  PathVertex vx;
+  if (collided) {
+    s.x += t * s.w;
+    s.beta *= vtx_albedo(VERTEX_MEDIUM);
+    vx = vtx_medium(s.x, s.w);
+  } else {
+    s.x += hit.t * s.w;
+    vx = vtx_surface(s.x, s.w, hit.prim, surf_shading_normal(hit.prim, vec2(hit.u, hit.v), surf_normal(hit.prim)));
+  }
+#else
   s.x += t * s.w;
   s.beta *= vtx_albedo(VERTEX_MEDIUM);
+  PathVertex vx = vtx_medium(s.x, s.w);
+#endif
   if (j > rsp.prefixVertices) {
     uvec4 h = rng_next4(rng);
     uint light;
     vec2 ls;
-    float pl = rs_sample_light(s.w, vec3(rng_to_float(h.x), rng_to_float(h.y), rng_to_float(h.z)), light, ls);
-    if (pl > 0.0f) s.L += s.beta * rs_light_term(VOL_CURRENT, VERTEX_MEDIUM, light, ls, s.x, s.w, true, rng) / pl;
+    uint prim;
+    float pl = rs_sample_light(vx, vec3(rng_to_float(h.x), rng_to_float(h.y), rng_to_float(h.z)), rng, light, ls, prim);
+    if (pl > 0.0f) s.L += s.beta * rs_light_term(VOL_CURRENT, vx, light, ls, prim, true, rng) / pl;
   }
   if (j == segments) return false;
   if (j >= frame.rrStartBounce) {
@@ -93,7 +132,17 @@ bool rs_tail_segment(inout RsTail s, inout RngState rng) {
     if (rng_float(rng) >= q) return false;
     s.beta /= q;
   }
+#ifdef PLUME_HAS_SURFACES
+  vec3 wNext;
+  float pdfDir;
+  s.beta *= vtx_at_sample(vx, rng_float2(rng), wNext, pdfDir);
+  if (!(pdfDir > 0.0f)) return false;
+  s.pdfDir = vtx_at_pdf(vx, wNext);
+  s.x = vtx_at_origin(vx, wNext);
+  s.w = wNext;
+#else
   s.w = vtx_sample(VERTEX_MEDIUM, s.w, rng_float2(rng));
+#endif
   s.j = j + 1u;
   return true;
 }
@@ -115,16 +164,33 @@ vec3 rs_shade(RsDomain D, uint pixelIndex, uint set, inout RngState rng) {
   RsReservoir r = rs_load(set, pixelIndex);
   vec3 L = vec3(0.0f);
   if (r.W > 0.0f) L += r.W * rs_path_contribution(D, set, pixelIndex, true, rng);
-#ifdef PLUME_HAS_ENV
+#if defined(PLUME_HAS_ENV) || defined(PLUME_HAS_EMITTERS)
+  // The camera ray's end: the environment where it escapes, an emitter's front side where it
+  // hits one (a surface blocks the environment); one-segment paths, which no candidate ends with.
   vec3 dir = rs_domain_dir(D, rng_float2(rng));
+#ifdef PLUME_HAS_SURFACES
+  BvhHit hit = bvh_closest(D.origin, dir, 0.0f, SURF_FAR);
+  if (hit.prim != BVH_NONE) {
+    L += surf_emitted(hit.prim, surf_normal(hit.prim), dir) * vol_residual_tr(D.origin, dir, hit.t, rng);
+  } else {
+    L += light_escaped(dir) * vol_residual_tr(D.origin, dir, DDA_INF, rng);
+  }
+#else
   L += light_escaped(dir) * vol_residual_tr(D.origin, dir, DDA_INF, rng);
+#endif
 #endif
 #ifdef PLUME_HAS_EMISSION
   // The medium's emission seen directly (paths of one vertex, which no candidate ends with),
   // gathered along a camera ray with ratio tracking's running transmittance (vol_emission_along:
-  // no collision is needed, so the whole ray counts). A self-lit fire is mostly this term; the
-  // reservoirs carry the light the fire and the lights scatter.
-  L += (vec3(1.0f) - vtx_albedo(VERTEX_MEDIUM)) * vol_emission_along(D.origin, rs_domain_dir(D, rng_float2(rng)), DDA_INF, rng);
+  // no collision is needed, so the whole ray counts, up to the first surface). A self-lit fire is
+  // mostly this term; the reservoirs carry the light the fire and the lights scatter.
+  vec3 dirE = rs_domain_dir(D, rng_float2(rng));
+  float tEnd = DDA_INF;
+#ifdef PLUME_HAS_SURFACES
+  BvhHit hitE = bvh_closest(D.origin, dirE, 0.0f, SURF_FAR);
+  if (hitE.prim != BVH_NONE) tEnd = hitE.t;
+#endif
+  L += (vec3(1.0f) - vtx_albedo(VERTEX_MEDIUM)) * vol_emission_along(D.origin, dirE, tEnd, rng);
 #endif
   return L;
 }

@@ -59,6 +59,11 @@ const uint BIND_BLACKBODY = 21u;       // vec4[]: the blackbody table (shared/bl
 const uint BIND_PREV_EMISSION_ATLAS = 22u;  // sampler3D: the previous frame's (ReSTIR's history)
 const uint EMISSION_BINDING_COUNT = 23u;  // binding tables that may hold the emission extend to it
 
+// ReSTIR's passes hold the surfaces' buffers (BIND_BVH_NODES .. BIND_EMITTERS) shifted by this
+// (PLUME_SURF_BINDING_SHIFT in surface/surfaces.glsl): 23 .. 27, past the emission's.
+const uint RS_SURF_BINDING_SHIFT = EMISSION_BINDING_COUNT - BIND_BVH_NODES;
+const uint RS_SURFACE_BINDING_COUNT = BIND_EMITTERS + RS_SURF_BINDING_SHIFT + 1u;
+
 PLUME_NS_END
 
 #endif

@@ -8,13 +8,17 @@
 //   (w_i, t_i), i = 2..n    direction and distance of each further vertex (n <= RS_MAX_VERTICES)
 //   (light, u)              the light sample that ends the path: light index and two floats
 //                           (a direction for suns with a disk and the environment, unused for a
-//                           delta sun or a point light); or light = RS_LIGHT_EMISSION: the path
+//                           delta sun or a point light; for the emissive triangles, light index
+//                           GpuFrame.lightCount, the triangle and a point's barycentrics: a point
+//                           in area measure); or light = RS_LIGHT_EMISSION: the path
 //                           ends with the medium's emission at x_n (x_n absorbs instead of
 //                           scattering: sigma_a Le there, n - 1 scattering vertices)
 // Its contribution f_D(y) in a domain D (pixel of a frame, volume) is measured in du dv dt1 dw2 dt2 ... dw_L,
 // so copying the coordinates into another domain has Jacobian 1 and the light reconnection to a
-// direction or a point has none either. A future surface vertex is one more kind of vertex in
-// the same list (a bit in RsPathHead.kinds), with its own measure and Jacobian.
+// direction or a point has none either. A surface vertex (bit i - 1 of RsPathHead.kinds set) is
+// "the first surface along w_i": its coordinate is the direction alone (t_i is stored but implied
+// by the domain's geometry), so the copy has Jacobian 1 there too, and the shift fails (f = 0)
+// where the copied ray's first event is of the other kind (notes/restir.md "Surfaces").
 #ifndef PLUME_SHARED_RESTIR_TYPES_H
 #define PLUME_SHARED_RESTIR_TYPES_H
 
@@ -38,6 +42,9 @@ const uint RS_CANDIDATE_VERTICES = 64u;
 // the candidates' running reservoir (1), the tail's walk (5, restir/shade.glsl RsTail).
 const uint RS_STATE_SLOTS = 5u;
 const uint RS_LIGHT_EMISSION = 0xFFFFFFFFu;  // RsPathHead.light of a path ending in emission
+// RsPathHead.light of a path whose last vertex is an emissive surface hit by the direction sampled
+// at the vertex before it (its emission weighted by MIS against the emitters' light samples)
+const uint RS_LIGHT_EMITTER_HIT = 0xFFFFFFFEu;
 
 const uint RS_MIS_PAIRWISE = 0u;  // pairwise MIS with confidence weights (default, O(k))
 const uint RS_MIS_GBH = 1u;       // generalised balance heuristic (O(k^2))
@@ -53,7 +60,7 @@ struct RsPathHead {
   uint light;        // index of the light that ends the path, or RS_LIGHT_EMISSION
   uint kinds;        // vertex kinds, one bit per vertex (integrator/vertex.glsl; 0: all media)
   uint uv;           // sub-pixel position (u, v) as two 16-bit unorms (restir/bridge.glsl)
-  uint pad0;
+  uint lightPrim;    // an emissive-triangle light sample's triangle (lightSample: its barycentrics)
 };
 
 // Per-frame parameters of the ReSTIR passes (beside GpuFrame, which holds the current camera),

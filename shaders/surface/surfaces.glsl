@@ -11,16 +11,21 @@
 #include "../shared/bvh.h"
 #include "../shared/surface_types.h"
 
-layout(std430, binding = BIND_BVH_NODES) readonly buffer BvhNodeBuffer { BvhNode bvhNodes[]; };
-layout(std430, binding = BIND_BVH_TRIANGLES) readonly buffer BvhTriangleBuffer { BvhTriangle bvhTriangles[]; };
+// The estimator's binding numbers may be shifted as a block (ReSTIR's passes use 11-15 for their
+// own buffers: shared/bindings.h BIND_RS_SURFACES); the path tracer's are BIND_BVH_NODES ...
+#ifndef PLUME_SURF_BINDING_SHIFT
+#define PLUME_SURF_BINDING_SHIFT 0u
+#endif
+layout(std430, binding = BIND_BVH_NODES + PLUME_SURF_BINDING_SHIFT) readonly buffer BvhNodeBuffer { BvhNode bvhNodes[]; };
+layout(std430, binding = BIND_BVH_TRIANGLES + PLUME_SURF_BINDING_SHIFT) readonly buffer BvhTriangleBuffer { BvhTriangle bvhTriangles[]; };
 #define BVH_NODE(i) bvhNodes[i]
 #define BVH_TRIANGLE(i) bvhTriangles[i]
 #include "bvh.glsl"
 
-layout(std430, binding = BIND_SURF_TRIANGLES) readonly buffer SurfTriangleBuffer { GpuSurfaceTriangle surfTriangles[]; };
-layout(std430, binding = BIND_SURF_MATERIALS) readonly buffer SurfMaterialBuffer { GpuSurfaceMaterial surfMaterials[]; };
+layout(std430, binding = BIND_SURF_TRIANGLES + PLUME_SURF_BINDING_SHIFT) readonly buffer SurfTriangleBuffer { GpuSurfaceTriangle surfTriangles[]; };
+layout(std430, binding = BIND_SURF_MATERIALS + PLUME_SURF_BINDING_SHIFT) readonly buffer SurfMaterialBuffer { GpuSurfaceMaterial surfMaterials[]; };
 #ifdef PLUME_HAS_EMITTERS
-layout(std430, binding = BIND_EMITTERS) readonly buffer EmitterBuffer { GpuEmitterAlias surfEmitters[]; };
+layout(std430, binding = BIND_EMITTERS + PLUME_SURF_BINDING_SHIFT) readonly buffer EmitterBuffer { GpuEmitterAlias surfEmitters[]; };
 #endif
 
 const float SURF_FAR = 3.0e38f;
@@ -66,21 +71,36 @@ bool surf_occluded(vec3 o, vec3 d, float tMax) { return bvh_any(o, d, 0.0f, tMax
 // The area density with which surf_sample_emitter picks a point of triangle prim (0: it is dark).
 float surf_emitter_pdf(uint prim) { return surfTriangles[prim].lightPdf; }
 
+// An emissive triangle from the alias table (u: the table entry, its coin), chosen with
+// probability proportional to its power.
+uint surf_pick_emitter(vec2 u) {
+  uint i = min(uint(u.x * float(frame.emitterCount)), frame.emitterCount - 1u);
+  GpuEmitterAlias e = surfEmitters[i];
+  return u.y < e.keep ? e.triangle : surfEmitters[e.alias].triangle;
+}
+
+// A uniform point of triangle prim from u in [0,1)² (the square-root map, as the reference), as
+// barycentrics (b1, b2) of v1 and v2.
+vec2 surf_uniform_barycentrics(vec2 u) {
+  float r = sqrt(u.x);
+  return vec2(r * (1.0f - u.y), r * u.y);
+}
+
+vec3 surf_triangle_point(uint prim, vec2 b) {
+  GpuSurfaceTriangle t = surfTriangles[prim];
+  return (1.0f - b.x - b.y) * t.v0 + b.x * t.v1 + b.y * t.v2;
+}
+
+vec3 surf_emission(uint prim) { return surfMaterials[surfTriangles[prim].surface].emission; }
+
 // A point on the emissive triangles (u in [0,1)⁴: the table entry, its coin, then the point):
 // its position, front normal, radiance and area density.
 void surf_sample_emitter(vec4 u, out vec3 p, out vec3 n, out vec3 Le, out float pdfArea) {
-  uint i = min(uint(u.x * float(frame.emitterCount)), frame.emitterCount - 1u);
-  GpuEmitterAlias e = surfEmitters[i];
-  uint prim = u.y < e.keep ? e.triangle : surfEmitters[e.alias].triangle;
-  GpuSurfaceTriangle t = surfTriangles[prim];
-  // Uniform in the triangle (the square-root map, as the reference).
-  float r = sqrt(u.z);
-  float b1 = r * (1.0f - u.w);
-  float b2 = r * u.w;
-  p = (1.0f - b1 - b2) * t.v0 + b1 * t.v1 + b2 * t.v2;
-  n = normalize(cross(t.v1 - t.v0, t.v2 - t.v0));
-  Le = surfMaterials[t.surface].emission;
-  pdfArea = t.lightPdf;
+  uint prim = surf_pick_emitter(u.xy);
+  p = surf_triangle_point(prim, surf_uniform_barycentrics(u.zw));
+  n = surf_normal(prim);
+  Le = surf_emission(prim);
+  pdfArea = surf_emitter_pdf(prim);
 }
 #endif
 

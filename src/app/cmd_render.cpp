@@ -112,7 +112,7 @@ int runRender(const RenderArgs& a) {
   Scene scene = loadJobScene(a);
   const RenderSettings& rs = scene.render;
   const EstimatorKind kind = estimatorKind(rs);
-  checkGpuSupports(scene, "--mode " + rs.mode, kind == EstimatorKind::PathTracer);  // before any output
+  checkGpuSupports(scene, "--mode " + rs.mode, true);  // before any output
   const EstimatorTraits& traits = estimatorTraits(kind);
   if (a.preroll > 0 && !traits.carriesHistory) {
     logInfo(strf("--preroll %d: no effect with mode %s (its frames are independent)", a.preroll, rs.mode.c_str()));

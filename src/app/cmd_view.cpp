@@ -24,9 +24,10 @@ int runView(ViewArgs& a) {
   setQuiet(a.options.quiet);
   Scene scene = loadScene(a.scene);
   applyOverrides(scene.render, a.overrides);
-  // The path tracer renders surfaces; a mode that does not is refused here, and switching to it
-  // in the panel shows the same message and stays with the path tracer (Viewer::rebuildRenderer).
-  checkGpuSupports(scene, "--mode " + scene.render.mode, estimatorKind(scene.render) == EstimatorKind::PathTracer);
+  // Every estimator renders surfaces (the path tracer and ReSTIR); a mode that did not would be
+  // refused here, and switching to it in the panel would show the same message and stay with the
+  // path tracer (Viewer::rebuildRenderer).
+  checkGpuSupports(scene, "--mode " + scene.render.mode, true);
   if (a.width > 0) scene.camera.width = a.width;
   if (a.height > 0) scene.camera.height = a.height;
   if (scene.media.empty()) throw InputError(scene.path + ": media: the viewer needs a medium");

@@ -189,10 +189,6 @@ BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Sce
     });
     if (variants.empty()) throw InputError("bench: no ReSTIR variant matches --only");
   }
-  if (!scene.surfaces.empty() && !variants.empty()) {
-    logWarn("bench: ReSTIR does not render surfaces yet (issue 12): its rows are left out");
-    variants.clear();
-  }
   // One frame's grid (the first of the scene's range unless chosen), held still: the bench measures
   // the estimators, not the animation. Frame numbers count from it.
   const int first = o.gridFrame >= 0 ? o.gridFrame : scene.render.frameFirst;

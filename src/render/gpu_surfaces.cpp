@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <vector>
 
 namespace plume {
@@ -90,6 +91,7 @@ GpuSurfaces::GpuSurfaces(gpu::Context& ctx, const Scene& scene) {
     const double a = 0.5 * geo::doubleArea(mesh, i);
     const double p = a * (double(le.x) + double(le.y) + double(le.z)) / 3.0;
     if (p > 0.0) {
+      emitterSummary_.push_back({(t.v0 + t.v1 + t.v2) / 3.0f, glm::normalize(glm::cross(t.v1 - t.v0, t.v2 - t.v0)), p});
       emitters.push_back(uint32_t(i));
       power.push_back(p);
       area.push_back(a);
@@ -111,12 +113,23 @@ GpuSurfaces::GpuSurfaces(gpu::Context& ctx, const Scene& scene) {
                mesh.triangleCount(), emitterCount_, stats_.nodes, stats_.bytesPerTriangle(), stats_.buildMs));
 }
 
-void GpuSurfaces::bind(gpu::DescriptorSet& set) const {
-  set.bind(shared::BIND_BVH_NODES, nodes_);
-  set.bind(shared::BIND_BVH_TRIANGLES, bvhTriangles_);
-  set.bind(shared::BIND_SURF_TRIANGLES, triangles_);
-  set.bind(shared::BIND_SURF_MATERIALS, materials_);
-  set.bind(shared::BIND_EMITTERS, emitters_);
+void GpuSurfaces::bind(gpu::DescriptorSet& set, uint32_t shift) const {
+  set.bind(shared::BIND_BVH_NODES + shift, nodes_);
+  set.bind(shared::BIND_BVH_TRIANGLES + shift, bvhTriangles_);
+  set.bind(shared::BIND_SURF_TRIANGLES + shift, triangles_);
+  set.bind(shared::BIND_SURF_MATERIALS + shift, materials_);
+  set.bind(shared::BIND_EMITTERS + shift, emitters_);
+}
+
+double GpuSurfaces::emitterPowerAt(glm::vec3 p) const {
+  double sum = 0.0;
+  for (const EmitterSummary& e : emitterSummary_) {
+    const glm::dvec3 d = glm::dvec3(p) - glm::dvec3(e.centroid);
+    const double r2 = std::max(1e-12, glm::dot(d, d));
+    const double cosine = std::max(0.0, glm::dot(d, glm::dvec3(e.normal)) / std::sqrt(r2));
+    sum += e.power * cosine / (4.0 * M_PI * r2);
+  }
+  return sum;
 }
 
 }  // namespace plume

@@ -27,8 +27,12 @@ class GpuSurfaces {
   // larger than the device's storage buffers allow (the message names the buffer).
   GpuSurfaces(gpu::Context& ctx, const Scene& scene);
 
-  // Binds BIND_BVH_NODES .. BIND_EMITTERS.
-  void bind(gpu::DescriptorSet& set) const;
+  // Binds BIND_BVH_NODES .. BIND_EMITTERS, each shifted by `shift` (surface/surfaces.glsl
+  // PLUME_SURF_BINDING_SHIFT).
+  void bind(gpu::DescriptorSet& set, uint32_t shift = 0) const;
+  // A rough estimate of the emitters' radiance scattered at p, phase-averaged:
+  // sum of mean(Le) A max(cos, 0) / (4 pi r^2) over the emissive triangles (ReSTIR's light choice).
+  double emitterPowerAt(glm::vec3 p) const;
   uint32_t emitterCount() const { return emitterCount_; }
   const geo::BvhStats& bvhStats() const { return stats_; }
   double uploadMs() const { return uploadMs_; }
@@ -36,6 +40,11 @@ class GpuSurfaces {
  private:
   gpu::Buffer nodes_, bvhTriangles_, triangles_, materials_, emitters_;
   uint32_t emitterCount_ = 0;
+  struct EmitterSummary {
+    glm::vec3 centroid, normal;
+    double power;  // area times mean(Le)
+  };
+  std::vector<EmitterSummary> emitterSummary_;
   geo::BvhStats stats_;
   double uploadMs_ = 0.0;
 };

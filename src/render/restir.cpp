@@ -42,15 +42,19 @@ namespace {
 // (bundled smoke at 128², r2: 4.85x -> 5.26x static, 3.79x -> 3.70x moving with one light by
 // power; Blender smoke: 3.53x -> 5.19x and 2.72x -> 3.48x: the sky's light rays through dense
 // smoke carry almost nothing).
-// envMapMean: an environment map's mean radiance over the sphere (GpuEnvironmentMap).
-std::vector<shared::GpuLightChoice> lightChoice(const Scene& scene, glm::vec3 centre, glm::vec3 envMapMean) {
-  const size_t n = scene.lights.size();
+// envMapMean: an environment map's mean radiance over the sphere (GpuEnvironmentMap). With
+// emissive surfaces one more entry, after the scene's lights, stands for a point on them
+// (restir/bridge.glsl rs_sample_light), its estimate GpuSurfaces::emitterPowerAt(centre).
+std::vector<shared::GpuLightChoice> lightChoice(const Scene& scene, glm::vec3 centre, glm::vec3 envMapMean,
+                                                const GpuSurfaces* surfaces) {
+  const bool emitters = surfaces && surfaces->emitterCount() > 0;
+  const size_t n = scene.lights.size() + (emitters ? 1 : 0);
   std::vector<shared::GpuLightChoice> choice(std::max<size_t>(n, 1), shared::GpuLightChoice{});
   if (n == 0) return choice;
   auto lum = [](glm::vec3 c) { return std::max(0.0, (double(c.x) + c.y + c.z) / 3.0); };
   std::vector<double> power(n, 0.0);
   double total = 0.0;
-  for (size_t i = 0; i < n; ++i) {
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
     const Light& l = scene.lights[i];
     switch (l.type) {
       case LightType::Sun: power[i] = lum(l.irradiance) / (4.0 * M_PI); break;
@@ -62,6 +66,10 @@ std::vector<shared::GpuLightChoice> lightChoice(const Scene& scene, glm::vec3 ce
       case LightType::Environment: power[i] = l.map.empty() ? lum(l.radiance * l.scale) : lum(envMapMean); break;
     }
     total += power[i];
+  }
+  if (emitters) {
+    power[n - 1] = surfaces->emitterPowerAt(centre);
+    total += power[n - 1];
   }
   double cdf = 0.0;
   for (size_t i = 0; i < n; ++i) {
@@ -81,35 +89,41 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
                bool kernelCounters)
     : ctx_(ctx), scene_(scene), options_(options), features_(featuresOf(scene)), timer_(ctx, 32) {
   features_.kernelCounters = kernelCounters;
-  checkGpuSupports(scene, "ReSTIR");
+  checkGpuSupports(scene, "ReSTIR", true);
   envMap_ = std::make_unique<GpuEnvironmentMap>(ctx, scene);  // bad maps fail before compiling
+  if (features_.surfaces) surfaces_ = std::make_unique<GpuSurfaces>(ctx, scene);
   if (options_.prefix < 1 || options_.prefix > int(shared::RS_MAX_VERTICES)) {
     throw InputError(scene.path + strf(": render.restir_prefix: expected 1 to %u (got %d)", shared::RS_MAX_VERTICES,
                                        options_.prefix));
   }
   // Reservoirs hold paths of at most `prefix` vertices; a longer max_bounces adds the tail, a
   // path-traced estimate of the paths with more vertices, to final shading (restir/shade.glsl).
-  // In an emitting medium a reservoir's path may end with one more vertex that only emits
-  // (rs_emission_vertices: min(max_bounces, prefix) + 1, at most RS_MAX_VERTICES), and the tail
-  // also gathers the emission of longer paths.
+  // In an emitting medium, or with emissive surfaces (hit by a sampled direction), a reservoir's
+  // path may end with one more vertex that only emits (rs_emission_vertices: min(max_bounces,
+  // prefix) + 1, at most RS_MAX_VERTICES), and the tail also gathers the emission of longer paths.
+  const bool endsInEmission = features_.emission || features_.emitters;
   const int prefix = std::min(options_.prefix, std::max(1, scene.render.maxBounces));
   const int emitting = std::min({scene.render.maxBounces + 1, prefix + 1, int(shared::RS_MAX_VERTICES)});
-  const bool tail = scene.render.maxBounces > prefix || (features_.emission && scene.render.maxBounces + 1 > emitting);
-  const int vertices = features_.emission ? emitting : prefix;  // stored per path
+  const bool tail = scene.render.maxBounces > prefix || (endsInEmission && scene.render.maxBounces + 1 > emitting);
+  const int vertices = endsInEmission ? emitting : prefix;  // stored per path
   if (options_.neighbours > int(shared::RS_MAX_NEIGHBOURS)) {
     throw InputError(scene.path + strf(": render.restir_neighbours: at most %u", shared::RS_MAX_NEIGHBOURS));
   }
   using gpu::BindingType;
   // shaders/restir/bindings.glsl (numbers in shaders/shared/bindings.h)
   // Every binding in a table must be written before a dispatch (lavapipe reads them all): the
-  // emission's exist only in the tables of an emitting scene.
+  // emission's exist only in the tables of an emitting scene, the surfaces' (past the emission's)
+  // only in those of a scene with surfaces.
+  const uint32_t count = features_.surfaces ? shared::RS_SURFACE_BINDING_COUNT
+                         : features_.emission ? shared::EMISSION_BINDING_COUNT
+                                              : shared::RS_BINDING_COUNT;
   const std::vector<BindingType> bindings =
       features_.emission
-          ? gpu::bindingTable(shared::EMISSION_BINDING_COUNT,
+          ? gpu::bindingTable(count,
                               {{shared::BIND_ATLAS, BindingType::SampledImage}, {shared::BIND_PREV_ATLAS, BindingType::SampledImage},
                                {shared::BIND_EMISSION_ATLAS, BindingType::SampledImage},
                                {shared::BIND_PREV_EMISSION_ATLAS, BindingType::SampledImage}})
-          : gpu::bindingTable(shared::RS_BINDING_COUNT, {{shared::BIND_ATLAS, BindingType::SampledImage},
+          : gpu::bindingTable(count, {{shared::BIND_ATLAS, BindingType::SampledImage},
                                                          {shared::BIND_PREV_ATLAS, BindingType::SampledImage}});
   const gpu::ShaderDefines defines = features_.defines();
   const std::string variant = " [" + features_.name() + "]";
@@ -138,7 +152,7 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   // segments (one more in an emitting medium).
   if (tail) {
     tail_ = make("passes/restir_tail.comp", "restir tail", {});
-    const uint32_t segments = uint32_t(scene.render.maxBounces) + (features_.emission ? 1u : 0u);
+    const uint32_t segments = uint32_t(scene.render.maxBounces) + (endsInEmission ? 1u : 0u);
     tailDispatches_ = (segments + shared::RS_TAIL_SEGMENTS - 1) / shared::RS_TAIL_SEGMENTS;
   }
 
@@ -149,7 +163,8 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   const std::vector<shared::GpuLight> lights = gpuLights(scene);
   lightBuffer_ = gpu::Buffer(ctx, lights.size() * sizeof(shared::GpuLight), storage, "lights");
   lightBuffer_.upload(lights.data(), lights.size() * sizeof(shared::GpuLight));
-  lightChoice_ = gpu::Buffer(ctx, lights.size() * sizeof(shared::GpuLightChoice), storage, "light choice");
+  const size_t choices = std::max(lights.size(), scene.lights.size() + (features_.emitters ? 1 : 0));
+  lightChoice_ = gpu::Buffer(ctx, choices * sizeof(shared::GpuLightChoice), storage, "light choice");
   paramBuffer_ = gpu::Buffer(ctx, sizeof(shared::RestirParams), storage, "restir parameters");
   reservoirs_ = gpu::Buffer(ctx, kSets * pixels * sizeof(shared::RsPacked), storage, "reservoirs");
   paths_ = gpu::Buffer(ctx, kSets * pixels * sizeof(shared::RsPathHead), storage, "reservoir paths");
@@ -166,6 +181,7 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
     p->set.bind(shared::BIND_LIGHTS, lightBuffer_);
     p->set.bind(shared::BIND_LIGHT_CHOICE, lightChoice_);
     envMap_->bind(p->set);
+    if (surfaces_) surfaces_->bind(p->set, shared::RS_SURF_BINDING_SHIFT);
     p->set.bind(shared::BIND_RS_PARAMS, paramBuffer_);
     p->set.bind(shared::BIND_RS_RESERVOIRS, reservoirs_);
     p->set.bind(shared::BIND_RS_PATHS, paths_);
@@ -176,9 +192,10 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   params_.candidates = uint32_t(options_.candidates);
   params_.bounceStride = stride;
   params_.prefixVertices = uint32_t(prefix);
-  params_.walksPerDispatch = std::max(1u, shared::RS_CANDIDATE_VERTICES / uint32_t(features_.emission ? emitting : prefix));
+  params_.walksPerDispatch = std::max(1u, shared::RS_CANDIDATE_VERTICES / uint32_t(endsInEmission ? emitting : prefix));
   params_.pixelCount = uint32_t(pixels);
-  params_.lightCount = uint32_t(scene.lights.size());
+  // The scene's lights and, with emissive surfaces, one entry for a point on them.
+  params_.lightCount = uint32_t(scene.lights.size()) + (surfaces_ && surfaces_->emitterCount() > 0 ? 1u : 0u);
   params_.historyCap = float(options_.historyCap);
   params_.reprojectionDepth = 1.0f;
   params_.neighbours = uint32_t(options_.neighbours);
@@ -199,7 +216,7 @@ void Restir::setVolumes(const GpuVolumeResources& current, const GpuVolumeResour
   centre_ = centre;
   currentSerial_ = current.serial();
   previousSerial_ = previous.serial();
-  const std::vector<shared::GpuLightChoice> choice = lightChoice(scene_, centre, envMap_->meanRadiance());
+  const std::vector<shared::GpuLightChoice> choice = lightChoice(scene_, centre, envMap_->meanRadiance(), surfaces_.get());
   lightChoice_.upload(choice.data(), choice.size() * sizeof(shared::GpuLightChoice));
 }
 
@@ -213,6 +230,7 @@ void Restir::resetHistory() { hasHistory_ = false; }
 
 void Restir::fillFrame(int frame, uint32_t sequence, uint32_t key) {
   frame_ = gpuFrame(scene_, frame, uint32_t(scene_.render.seed) + 0x9E3779B9u * sequence, key, 1u);
+  frame_.emitterCount = surfaces_ ? surfaces_->emitterCount() : 0u;
   const shared::GpuCamera& cam = frame_.camera;
   const bool history = hasHistory_ && options_.historyCap > 0 && prevSequence_ == sequence;
   if (history) params_.prevCamera = prevCam_;

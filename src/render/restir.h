@@ -15,6 +15,7 @@
 #include "gpu/shader_compiler.h"
 #include "io/image.h"
 #include "render/gpu_envmap.h"
+#include "render/gpu_surfaces.h"
 #include "render/gpu_volume.h"
 #include "render/path_tracer.h"
 #include "scene/scene.h"
@@ -84,6 +85,7 @@ class Restir {
   RestirOptions options_;
   FeatureSet features_;
   std::unique_ptr<GpuEnvironmentMap> envMap_;
+  std::unique_ptr<GpuSurfaces> surfaces_;  // only for a scene with surfaces
   std::unique_ptr<gpu::ComputePass> candidates_, temporal_, spatial_, shade_;
   std::unique_ptr<gpu::ComputePass> tail_;  // final shading's tail (null without one)
   uint32_t tailDispatches_ = 0;             // its dispatches per frame

@@ -182,17 +182,22 @@ EstimatorRun runPtCase(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const E
 
 EstimatorRun runRestirCase(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const ExtremeCase& c, int runs,
                            uint32_t mis) {
+  RestirOptions o;
+  o.rounds = 1;
+  o.radius = 2;
+  o.historyCap = 0;
+  o.mis = mis;
+  return runRestirCase(ctx, compiler, c, runs, o);
+}
+
+EstimatorRun runRestirCase(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const ExtremeCase& c, int runs,
+                           const RestirOptions& o) {
   const auto start = Clock::now();
   LoadedGrid loaded;
   loaded.grid = c.grid;
   loaded.name = "density";
   const BakedVolume bake = bakeVolume(loaded);
   GpuVolumeResources volume(ctx, bake, c.scene.media[0].densityScale);
-  RestirOptions o;
-  o.rounds = 1;
-  o.radius = 2;
-  o.historyCap = 0;
-  o.mis = mis;
   Restir restir(ctx, compiler, c.scene, o);
   restir.setVolumes(volume, volume);
   // Mean and variance of the mean over independent runs, per pixel and of the image mean.

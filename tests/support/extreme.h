@@ -11,6 +11,7 @@
 #include "core/image.h"
 #include "gpu/context.h"
 #include "gpu/shader_compiler.h"
+#include "render/restir.h"
 #include "scene/scene.h"
 
 #include <openvdb/openvdb.h>
@@ -60,6 +61,9 @@ EstimatorRun runPtCase(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const E
 // (radius 2, one round, no history), so that per-pixel variances are honest.
 EstimatorRun runRestirCase(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const ExtremeCase& c, int runs,
                            uint32_t mis);
+// The same with any options (each run one frame from a reset history).
+EstimatorRun runRestirCase(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const ExtremeCase& c, int runs,
+                           const RestirOptions& options);
 
 uint64_t countNonFinite(const Image& image);
 

@@ -1,4 +1,4 @@
-// Lights for test scenes built in code.
+// Lights, surfaces and a scene for tests that build scenes in code.
 #pragma once
 
 #include "scene/scene.h"
@@ -20,6 +20,70 @@ inline Light skyLight(glm::vec3 radiance) {
   l.type = LightType::Environment;
   l.radiance = radiance;
   return l;
+}
+
+// A plane surface (diffuse by default) of the given centre, normal and size.
+inline Surface planeSurface(glm::vec3 centre, glm::vec3 normal, glm::vec2 size) {
+  Surface s;
+  s.plane = SurfacePlane{centre, normal, size};
+  return s;
+}
+
+// A black plane that emits `radiance` from its front (the side `normal` points to).
+inline Surface emitterSurface(glm::vec3 centre, glm::vec3 normal, glm::vec2 size, glm::vec3 radiance) {
+  Surface s = planeSurface(centre, normal, size);
+  s.albedo = glm::vec3(0.0f);
+  s.emission = radiance;
+  return s;
+}
+
+// The noise cloud (about [0, 2]³; support/grids.h makeNoiseGrid(32, 1.0 / 16, seed)) over a
+// diffuse ground plane at y = 0, seen from the front, under a sun and a constant sky.
+inline Scene smokeOverGroundScene(int size, int bounces) {
+  Scene s;
+  s.path = "surface-scene";
+  s.camera.base.position = {1.0f, 1.4f, 4.6f};
+  s.camera.base.lookAt = {1.0f, 0.7f, 1.0f};
+  s.camera.base.fovY = 40.0f;
+  s.camera.width = s.camera.height = size;
+  s.media.push_back(Medium{});
+  s.medium().densityScale = 3.0f;
+  s.medium().albedo = glm::vec3(0.9f);
+  s.medium().g = 0.3f;
+  s.lights = {sunLight({0.5f, 1.0f, 0.3f}, {3.0f, 2.8f, 2.5f}), skyLight({0.10f, 0.12f, 0.16f})};
+  Surface ground = planeSurface({1.0f, 0.0f, 1.0f}, {0, 1, 0}, {8.0f, 8.0f});
+  ground.albedo = glm::vec3(0.6f, 0.5f, 0.4f);
+  s.surfaces.push_back(ground);
+  s.render.maxBounces = bounces;
+  return s;
+}
+
+// The ground scene with an occluding quad between the sun and the smoke and a glossy copper
+// conductor quad (GGX, alpha 0.3) beside it.
+inline Scene occluderAndConductorScene(int size, int bounces) {
+  Scene s = smokeOverGroundScene(size, bounces);
+  Surface occluder = planeSurface({1.4f, 2.6f, 1.2f}, {0.2f, 1.0f, 0.1f}, {1.0f, 1.0f});
+  occluder.albedo = glm::vec3(0.3f);
+  Surface metal = planeSurface({2.4f, 0.8f, 0.4f}, {-1.0f, 0.2f, 0.6f}, {1.2f, 1.4f});
+  metal.material = SurfaceMaterial::Conductor;
+  metal.roughness = 0.3f;
+  metal.f0 = glm::vec3(0.95f, 0.64f, 0.54f);
+  s.surfaces.push_back(occluder);
+  s.surfaces.push_back(metal);
+  return s;
+}
+
+// The ground scene lit only by three emissive quads (one facing down onto the ground from
+// `lowQuadHeight`, its back to the camera: at 2 cm only the bounce carries its light, and the
+// points of the ground next to it see its light from very close, 1/d² up to 2500, which an
+// estimator without BSDF-sampled hits (ReSTIR's: emitters by NEE only) resolves slowly).
+inline Scene emissiveQuadsScene(int size, int bounces, float lowQuadHeight = 0.02f) {
+  Scene s = smokeOverGroundScene(size, bounces);
+  s.lights.clear();
+  s.surfaces.push_back(emitterSurface({0.2f, 2.4f, 1.0f}, {0.3f, -1.0f, 0.0f}, {0.5f, 0.5f}, {12.0f, 9.0f, 6.0f}));
+  s.surfaces.push_back(emitterSurface({1.8f, 2.2f, 0.6f}, {-0.2f, -1.0f, 0.3f}, {0.3f, 0.6f}, {4.0f, 6.0f, 12.0f}));
+  s.surfaces.push_back(emitterSurface({1.0f, lowQuadHeight, 2.6f}, {0.0f, -1.0f, 0.0f}, {0.6f, 0.6f}, {50.0f, 50.0f, 50.0f}));
+  return s;
 }
 
 }  // namespace plume::test

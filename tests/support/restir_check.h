@@ -1,0 +1,70 @@
+// ReSTIR against the CPU reference on a scene built in code
+// (tests/test_restir_surfaces*.cpp): independent one-frame runs of spatial
+// reuse (support/extreme.h runRestirCase), the per-pixel and aggregate checks
+// of support/reference_check.h, for each MIS kind asked for.
+#pragma once
+
+#include "reference/reference.h"
+#include "render/restir.h"
+#include "support/extreme.h"
+#include "support/reference_check.h"
+
+#include <cstdio>
+#include <string>
+#include <vector>
+
+namespace plume::test {
+
+// The CPU reference of scene s at spp (seed 4242).
+inline Image restirCheckReference(Scene s, openvdb::FloatGrid::Ptr grid,
+                                  int spp) {
+  s.render.spp = spp;
+  s.render.seed = 4242;
+  ref::ReferenceOptions opt;
+  opt.progress = false;
+  return ref::renderReference(s, grid, opt);
+}
+
+// One spatial round (k 3, radius 4), no history, MIS kind mis.
+inline RestirOptions spatialReuse(uint32_t mis) {
+  RestirOptions o;
+  o.rounds = 1;
+  o.radius = 4;
+  o.historyCap = 0;
+  o.mis = mis;
+  return o;
+}
+
+// ReSTIR (pairwise and GBH, or only `misKinds`; `runs` independent runs each;
+// reservoirs holding paths of at most `prefix` vertices, the rest the tail's)
+// against one reference of refSpp.
+inline void expectRestirMatchesReference(
+    gpu::Context &ctx, gpu::ShaderCompiler &compiler, const Scene &s,
+    openvdb::FloatGrid::Ptr grid, int runs, int refSpp, const std::string &name,
+    std::vector<uint32_t> misKinds = {shared::RS_MIS_PAIRWISE,
+                                      shared::RS_MIS_GBH},
+    int prefix = RestirOptions{}.prefix) {
+  const Image ref = restirCheckReference(s, grid, refSpp);
+  ExtremeCase c;
+  c.name = name;
+  c.scene = s;
+  c.grid = grid;
+  for (const uint32_t mis : misKinds) {
+    const std::string label =
+        name + (mis == shared::RS_MIS_GBH ? "_gbh" : "_pairwise");
+    RestirOptions options = spatialReuse(mis);
+    options.prefix = prefix;
+    const EstimatorRun run = runRestirCase(ctx, compiler, c, runs, options);
+    ReferenceCheckOptions check;
+    check.imageMeanVariance = run.imageMeanVariance;
+    check.outputGroup = "restir_surfaces";
+    const ReferenceCheck result =
+        expectMatchesReference(run.image, ref, label, check);
+    EXPECT_EQ(run.truncated, 0u) << label;
+    EXPECT_EQ(run.nonFinite, 0u) << label;
+    std::printf("[restir surfaces] %s: %s (%.1f s)\n", label.c_str(),
+                result.summary().c_str(), run.seconds);
+  }
+}
+
+} // namespace plume::test
