@@ -1,6 +1,7 @@
 // ReSTIR pass 4b (DESIGN §4.2 step 7, with a tail): one dispatch of final shading's tail, at most
 // RS_TAIL_SEGMENTS segments of each pixel's walk (restir/shade.glsl); the host dispatches it until
-// every walk has ended (Restir::render). push.restartAccumulation as for pass 4.
+// every walk has ended (Restir::render: push.countAlive asks the last dispatch of a submit to count
+// the walks still alive). push.restartAccumulation as for pass 4.
 #version 450
 #extension GL_GOOGLE_include_directive : require
 
@@ -15,6 +16,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 void main() {
   uvec2 pixel = gl_GlobalInvocationID.xy;
   if (pixel.x >= frame.size.x || pixel.y >= frame.size.y) return;
-  rs_tail_pixel(pixel, push.restartAccumulation != 0u);
+  bool alive = rs_tail_pixel(pixel, push.restartAccumulation != 0u);
+  if (alive && push.countAlive != 0u) atomicAdd(rsCounters[RS_COUNTER_TAIL_ALIVE], 1u);
   loop_guard_check(frame.loopProbe);
 }

@@ -227,17 +227,18 @@ void rs_shade_pixel(uvec2 pixel, uint set, bool restart) {
 
 #ifdef PLUME_RS_TAIL
 // One dispatch of the tail's walk of `pixel` (passes/restir_tail.comp); the sample is accumulated
-// once the walk has ended.
-void rs_tail_pixel(uvec2 pixel, bool restart) {
+// once the walk has ended. Returns whether the walk is still alive after this dispatch.
+bool rs_tail_pixel(uvec2 pixel, bool restart) {
   uint index = pixel.y * frame.size.x + pixel.x;
   RsTail s = rs_tail_load(index);
-  if (s.j == 0u) return;  // ended in an earlier dispatch
+  if (s.j == 0u) return false;  // ended in an earlier dispatch
   RngState rng = rs_shading_rng(pixel);
   rng.counter = s.rngCounter;
   bool ended = rs_tail_advance(s, rng);
   s.rngCounter = rng.counter;
   if (ended) rs_accumulate(index, s.shaded + s.L, restart);
   rs_tail_store(index, s);
+  return !ended;
 }
 #endif
 

@@ -41,6 +41,10 @@ const uint RS_CANDIDATE_VERTICES = 64u;
 // vec4s per pixel of a pass's state between its dispatches (restir/bridge.glsl rs_state_slot):
 // the candidates' running reservoir (1), the tail's walk (5, restir/shade.glsl RsTail).
 const uint RS_STATE_SLOTS = 5u;
+// rsCounters[] (restir/bindings.glsl): [0] reservoirs dropped for non-finite weights,
+// [RS_COUNTER_TAIL_ALIVE] tail walks still alive after a counting dispatch (Restir::render).
+const uint RS_COUNTERS = 4u;
+const uint RS_COUNTER_TAIL_ALIVE = 1u;
 const uint RS_LIGHT_EMISSION = 0xFFFFFFFFu;  // RsPathHead.light of a path ending in emission
 // RsPathHead.light of a path whose last vertex is an emissive surface hit by the direction sampled
 // at the vertex before it (its emission weighted by MIS against the emitters' light samples)
@@ -94,7 +98,7 @@ struct RsPush {
   uint spatialRound;         // spatial reuse's round (its random stream)
   uint restartAccumulation;  // final shading: 1 restarts the accumulation, 0 adds to it
   uint candidate;            // candidates: the first walk m < M of this dispatch
-  uint pad1;
+  uint countAlive;           // tail: 1 counts the walks still alive after this dispatch
   uint pad2;
 };
 

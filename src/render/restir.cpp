@@ -172,7 +172,7 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   // The accumulation, then each pixel's state between the dispatches of a pass (the candidates'
   // running reservoir, the tail's walk: restir/bridge.glsl rs_state_slot).
   output_ = gpu::Buffer(ctx, (2 + shared::RS_STATE_SLOTS) * pixels * sizeof(glm::vec4), storage, "restir accumulation");
-  counters_ = gpu::Buffer(ctx, 16, storage, "restir counters");
+  counters_ = gpu::Buffer(ctx, shared::RS_COUNTERS * sizeof(uint32_t), storage, "restir counters");
   counters_.fillZero();
   reservoirs_.fillZero();
   paths_.fillZero();
@@ -262,6 +262,9 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
   const glm::uvec3 items(uint32_t(scene_.camera.width), uint32_t(scene_.camera.height), 1u);
   std::vector<std::string> labels;
   uint32_t finalSet = 0;
+  uint32_t tailDispatched = 0;
+  shared::RsPush tailPush{};
+  if (tail_) resetTailAlive();
   ctx_.submitAndWait([&](VkCommandBuffer cmd) {
     timer_.reset(cmd);
     const uint32_t hist = history_;
@@ -306,30 +309,63 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
     push.restartAccumulation = accumulate ? 0u : 1u;
     shade_->record(cmd, items, &push, &timer_);
     labels.push_back("shade");
-    if (tail_) {
-      const uint32_t scope = timer_.begin(cmd, "restir tail");
-      for (uint32_t i = 0; i < tailDispatches_; ++i) {
-        gpu::computeBarrier(cmd);
-        tail_->record(cmd, items, &push);
-      }
-      timer_.end(cmd, scope);
-      labels.push_back(strf("tail x%u", tailDispatches_));
-    }
+    tailPush = push;
+    if (tail_) tailDispatched = recordTail(cmd, push, 0);
     finalSet = cur;
   });
   passTimes_ = timer_.read();
+  if (tail_) labels.push_back("tail");
   for (size_t i = 0; i < passTimes_.size() && i < labels.size(); ++i) passTimes_[i].first = labels[i];
+  // The tail goes on, kTailDispatchesPerSubmit dispatches at a time, while a walk is still alive
+  // (the last dispatch of each submit counts them): a long max_bounces costs only the dispatches
+  // its longest walk needs, not max_bounces / RS_TAIL_SEGMENTS of them.
+  while (tail_ && tailDispatched < tailDispatches_ && tailAlive() > 0) {
+    ctx_.submitAndWait([&](VkCommandBuffer cmd) {
+      timer_.reset(cmd);
+      tailDispatched = recordTail(cmd, tailPush, tailDispatched);
+    });
+    for (const auto& [name, ms] : timer_.read()) passTimes_.back().second += ms;
+  }
+  if (tail_) passTimes_.back().first = strf("tail x%u", tailDispatched);
   history_ = finalSet;
   hasHistory_ = true;
   prevSequence_ = sequence;
 }
 
+// Records the tail's dispatches from `first` on, at most kTailDispatchesPerSubmit of them, the
+// last one counting the walks still alive after it (rsCounters[RS_COUNTER_TAIL_ALIVE]); returns
+// the number dispatched so far.
+uint32_t Restir::recordTail(VkCommandBuffer cmd, shared::RsPush push, uint32_t first) {
+  const glm::uvec3 items(uint32_t(scene_.camera.width), uint32_t(scene_.camera.height), 1u);
+  const uint32_t last = std::min(tailDispatches_, first + kTailDispatchesPerSubmit);
+  const uint32_t scope = timer_.begin(cmd, "restir tail");
+  for (uint32_t i = first; i < last; ++i) {
+    gpu::computeBarrier(cmd);
+    push.countAlive = i + 1 == last ? 1u : 0u;
+    tail_->record(cmd, items, &push);
+  }
+  timer_.end(cmd, scope);
+  return last;
+}
+
+uint32_t Restir::tailAlive() {
+  uint32_t alive = 0;
+  counters_.download(&alive, sizeof alive, shared::RS_COUNTER_TAIL_ALIVE * sizeof(uint32_t));
+  resetTailAlive();
+  return alive;
+}
+
+void Restir::resetTailAlive() {
+  const uint32_t zero = 0;
+  counters_.upload(&zero, sizeof zero, shared::RS_COUNTER_TAIL_ALIVE * sizeof(uint32_t));
+}
+
 uint32_t Restir::takeDroppedCount() {
-  uint32_t counters[4];
-  counters_.download(counters, sizeof counters);
-  const uint32_t zero[4] = {0, 0, 0, 0};
-  counters_.upload(zero, sizeof zero);
-  return counters[0];
+  uint32_t dropped = 0;
+  counters_.download(&dropped, sizeof dropped);
+  const uint32_t zero = 0;
+  counters_.upload(&zero, sizeof zero);
+  return dropped;
 }
 
 double Restir::lastFrameGpuMs() const {

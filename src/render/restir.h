@@ -78,6 +78,12 @@ class Restir {
 
  private:
   void fillFrame(int frame, uint32_t sequence, uint32_t key);
+  // Final shading's tail: records its dispatches from `first` on (at most kTailDispatchesPerSubmit,
+  // the last one counting the walks still alive); the count read back and reset.
+  static constexpr uint32_t kTailDispatchesPerSubmit = 4;
+  uint32_t recordTail(VkCommandBuffer cmd, shared::RsPush push, uint32_t first);
+  uint32_t tailAlive();
+  void resetTailAlive();
   std::vector<gpu::ComputePass*> passes() const;
 
   gpu::Context& ctx_;
@@ -88,7 +94,7 @@ class Restir {
   std::unique_ptr<GpuSurfaces> surfaces_;  // only for a scene with surfaces
   std::unique_ptr<gpu::ComputePass> candidates_, temporal_, spatial_, shade_;
   std::unique_ptr<gpu::ComputePass> tail_;  // final shading's tail (null without one)
-  uint32_t tailDispatches_ = 0;             // its dispatches per frame
+  uint32_t tailDispatches_ = 0;             // its dispatches per frame at most (max_bounces' walk)
   gpu::GpuTimer timer_;
   gpu::Buffer frameBuffer_, lightBuffer_, lightChoice_, paramBuffer_, reservoirs_, paths_, bounces_, output_, counters_;
   shared::GpuFrame frame_{};
