@@ -42,12 +42,7 @@ Light mapLight(const std::string& path, glm::vec3 up = {0, 1, 0}, float rotateYD
 std::string skyPath() { return test::sourcePath("volumes/sky/sky.exr"); }
 
 Scene cloudScene(int size) {
-  Scene s;
-  s.path = "test-scene";
-  s.camera.base.position = {1.0f, 1.2f, 4.0f};
-  s.camera.base.lookAt = {1.0f, 1.0f, 1.0f};
-  s.camera.base.fovY = 40.0f;
-  s.camera.width = s.camera.height = size;
+  Scene s = test::sceneWithCamera("test-scene", {1.0f, 1.2f, 4.0f}, {1.0f, 1.0f, 1.0f}, size);
   Medium m;
   m.densityScale = 4.0f;
   m.albedo = glm::vec3(0.9f);

@@ -31,12 +31,7 @@ namespace {
 class GpuRestir : public test::GpuTest {};
 
 Scene baseScene(int size) {
-  Scene s;
-  s.path = "test-scene";
-  s.camera.base.position = {1.0f, 1.2f, 3.6f};
-  s.camera.base.lookAt = {1.0f, 1.0f, 1.0f};
-  s.camera.base.fovY = 40.0f;
-  s.camera.width = s.camera.height = size;
+  Scene s = test::sceneWithCamera("test-scene", {1.0f, 1.2f, 3.6f}, {1.0f, 1.0f, 1.0f}, size);
   Medium m;
   m.densityScale = 6.0f;
   m.albedo = glm::vec3(0.8f, 0.85f, 0.9f);

@@ -133,44 +133,37 @@ TEST(View, SurfacesWithThePathTracerMatchAnOffscreenRender) {
   expectScriptedViewMatchesRender(test::sourcePath("volumes/smoke/smoke_ground.json"), "view_surfaces");
 }
 
-// ReSTIR with surfaces in the viewer (the bundled smoke over a ground beside a conductor
-// sphere): it renders, and the window shows the accumulated image.
-TEST(View, SurfacesWithRestirShowTheirAccumulatedImage) {
-  if (!haveXvfbRun()) GTEST_SKIP() << "xvfb-run is not installed";
-  const std::string dir = test::outputDir("view_restir_surfaces");
+// ReSTIR in the viewer: the display pass reads ReSTIR's device accumulation in place; the
+// presented window must equal the screenshot PNG (written from the read-back mean), and the
+// image is the scene (not uniform) with the accumulated iteration count.
+void expectRestirWindowShowsItsAccumulation(const std::string& scene, const std::string& name, int frames, int width,
+                                            int height) {
+  const std::string dir = test::outputDir(name);
   std::string log;
-  const std::vector<std::string> args = {test::sourcePath("volumes/smoke/smoke_ground.json"), "--mode", "restir",
-                                         "--frames", "3", "--screenshot", dir + "/view.png", "--capture-window",
-                                         dir + "/window.png", "--window-scale", "1", "--hide-ui", "--width", "48",
-                                         "--height", "32", "--seed", "3"};
+  const std::vector<std::string> args = {scene, "--mode", "restir", "--frames", std::to_string(frames),
+                                         "--screenshot", dir + "/view.png", "--capture-window", dir + "/window.png",
+                                         "--window-scale", "1", "--hide-ui", "--width", std::to_string(width),
+                                         "--height", std::to_string(height), "--seed", "3"};
   ASSERT_EQ(runView(args, log), 0) << log;
   EXPECT_EQ(log.find("validation:"), std::string::npos) << log;
   const Image view = readExr(dir + "/view.exr");
-  EXPECT_EQ(view.meta.at("spp"), "3");
+  EXPECT_EQ(view.meta.at("spp"), std::to_string(frames));
   double lo = 1e30, hi = -1e30;
   for (size_t i = 0; i < view.pixelCount(); ++i) lo = std::min(lo, luminance(view, i)), hi = std::max(hi, luminance(view, i));
   EXPECT_GT(hi - lo, 0.05) << "a uniform image is not the scene";
-  expectWindowIsTheScreenshot(dir, 48, 32);
+  expectWindowIsTheScreenshot(dir, width, height);
 }
 
-// ReSTIR in the viewer: the display pass reads ReSTIR's device accumulation in place; the
-// presented window must equal the screenshot PNG (written from the read-back mean), and the
-// image is the smoke with the accumulated iteration count.
+// ReSTIR with surfaces in the viewer (the bundled smoke over a ground beside a conductor sphere).
+TEST(View, SurfacesWithRestirShowTheirAccumulatedImage) {
+  if (!haveXvfbRun()) GTEST_SKIP() << "xvfb-run is not installed";
+  expectRestirWindowShowsItsAccumulation(test::sourcePath("volumes/smoke/smoke_ground.json"), "view_restir_surfaces", 3,
+                                         48, 32);
+}
+
 TEST(View, RestirWindowShowsItsAccumulatedImage) {
   if (!haveXvfbRun()) GTEST_SKIP() << "xvfb-run is not installed";
-  const std::string dir = test::outputDir("view_restir");
-  std::string log;
-  const std::vector<std::string> args = {kScene, "--mode", "restir", "--frames", "6", "--screenshot", dir + "/view.png",
-                                         "--capture-window", dir + "/window.png", "--window-scale", "1", "--hide-ui",
-                                         "--width", "64", "--height", "48", "--seed", "3"};
-  ASSERT_EQ(runView(args, log), 0) << log;
-  EXPECT_EQ(log.find("validation:"), std::string::npos) << log;
-  const Image view = readExr(dir + "/view.exr");
-  EXPECT_EQ(view.meta.at("spp"), "6");
-  double lo = 1e30, hi = -1e30;
-  for (size_t i = 0; i < view.pixelCount(); ++i) lo = std::min(lo, luminance(view, i)), hi = std::max(hi, luminance(view, i));
-  EXPECT_GT(hi - lo, 0.05) << "a uniform image is not the smoke";
-  expectWindowIsTheScreenshot(dir, 64, 48);
+  expectRestirWindowShowsItsAccumulation(kScene, "view_restir", 6, 64, 48);
 }
 
 TEST(View, PanelIsDrawnOverTheImageWhenShown) {

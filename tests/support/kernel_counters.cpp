@@ -31,12 +31,7 @@ BakedVolume makeEmittingCase(Scene& s) {
 }
 
 Scene smallScene(int size, int maxBounces) {
-  Scene s;
-  s.path = "test-scene";
-  s.camera.base.position = {0.5f, 0.6f, 2.2f};
-  s.camera.base.lookAt = {0.5f, 0.5f, 0.5f};
-  s.camera.base.fovY = 40.0f;
-  s.camera.width = s.camera.height = size;
+  Scene s = test::sceneWithCamera("test-scene", {0.5f, 0.6f, 2.2f}, {0.5f, 0.5f, 0.5f}, size);
   Medium m;
   m.densityScale = 6.0f;
   s.media.push_back(m);

@@ -5,7 +5,21 @@
 
 #include <glm/geometric.hpp>
 
+#include <string>
+
 namespace plume::test {
+
+// A scene with only its path and a square camera of `size` pixels at `position` looking at
+// `lookAt` (40° vertical field of view): what the tests' scenes start from.
+inline Scene sceneWithCamera(const std::string& path, glm::vec3 position, glm::vec3 lookAt, int size) {
+  Scene s;
+  s.path = path;
+  s.camera.base.position = position;
+  s.camera.base.lookAt = lookAt;
+  s.camera.base.fovY = 40.0f;
+  s.camera.width = s.camera.height = size;
+  return s;
+}
 
 inline Light sunLight(glm::vec3 toLight, glm::vec3 irradiance) {
   Light l;
@@ -40,12 +54,7 @@ inline Surface emitterSurface(glm::vec3 centre, glm::vec3 normal, glm::vec2 size
 // The noise cloud (about [0, 2]³; support/grids.h makeNoiseGrid(32, 1.0 / 16, seed)) over a
 // diffuse ground plane at y = 0, seen from the front, under a sun and a constant sky.
 inline Scene smokeOverGroundScene(int size, int bounces) {
-  Scene s;
-  s.path = "surface-scene";
-  s.camera.base.position = {1.0f, 1.4f, 4.6f};
-  s.camera.base.lookAt = {1.0f, 0.7f, 1.0f};
-  s.camera.base.fovY = 40.0f;
-  s.camera.width = s.camera.height = size;
+  Scene s = sceneWithCamera("surface-scene", {1.0f, 1.4f, 4.6f}, {1.0f, 0.7f, 1.0f}, size);
   s.media.push_back(Medium{});
   s.medium().densityScale = 3.0f;
   s.medium().albedo = glm::vec3(0.9f);
