@@ -12,6 +12,10 @@
 #include "../light/light.glsl"
 #include "../integrator/vertex.glsl"
 
+#ifndef PLUME_RS_LIGHT_CANDIDATES
+#define PLUME_RS_LIGHT_CANDIDATES 1  // light samples resampled at a candidate vertex (render/restir.cpp)
+#endif
+
 // A domain of the integral: one pixel of one frame (its camera and that frame's volume). The
 // pixel's box filter is part of the path: a path starts with its position (u, v) in [0, 1]² inside
 // the pixel, and the shift copies it, so a still camera's history is the same domain (identity
@@ -135,39 +139,100 @@ float rs_transmittance(uint v, vec3 x, vec3 w, float dist, bool unbiased, inout 
   return unbiased ? vol_residual_tr(x, w, dist, rng) : vol_mean_tr(v, x, w, dist);
 }
 
-// The light term at the path's last vertex vx: Le * scatter * T (times surface visibility; for a
-// point on an emissive triangle, per unit area: Le * scatter * cos_light / d² * T * V).
-vec3 rs_light_term(uint v, PathVertex vx, uint light, vec2 ls, uint prim, bool unbiased, inout RngState rng) {
+// The connection from the path's last vertex vx to a light sample: where the light ray starts
+// (o, pushed off a surface), its direction w and length `reach` (DDA_INF for distant lights; for
+// a point on an emissive triangle, short of the triangle itself), and the unshadowed light term
+// Le * scatter (for a point on an emissive triangle, per unit area: Le * scatter * cos_light / d²
+// with its MIS weight against direction sampling). False where it is 0 (the back of an emitter,
+// a direction outside the sun's disk).
+struct RsLightRay {
+  vec3 o;
+  vec3 w;
+  float reach;
+  vec3 value;
+};
+
+bool rs_light_connect(PathVertex vx, uint light, vec2 ls, uint prim, out RsLightRay c) {
 #ifdef PLUME_HAS_EMITTERS
   if (light == frame.lightCount) {
     vec3 p = surf_triangle_point(prim, ls);
-    vec3 o = vtx_at_origin(vx, p - vx.x);
-    vec3 toL = p - o;
+    c.o = vtx_at_origin(vx, p - vx.x);
+    vec3 toL = p - c.o;
     float dist = length(toL);
-    vec3 w = toL / dist;
-    float cosLight = -dot(surf_normal(prim), w);  // the back side emits nothing
-    if (!(dist > 0.0f) || !(cosLight > 0.0f)) return vec3(0.0f);
-    float reach = dist - surf_offset_length(p);  // stop short of the emitter's own triangle
-    if (surf_occluded(o, w, reach)) return vec3(0.0f);
-    vec3 scatter = vtx_at_scatter(vx, w);
-    float mis = rs_emitter_weight(rs_emitter_light_pdf(prim, dist, cosLight), vtx_at_pdf(vx, w));
-    return surf_emission(prim) * scatter * (mis * cosLight / (dist * dist)) * rs_transmittance(v, o, w, reach, unbiased, rng);
+    c.w = toL / dist;
+    float cosLight = -dot(surf_normal(prim), c.w);  // the back side emits nothing
+    c.reach = dist - surf_offset_length(p);  // stop short of the emitter's own triangle
+    c.value = vec3(0.0f);
+    if (!(dist > 0.0f) || !(cosLight > 0.0f)) return false;
+    vec3 scatter = vtx_at_scatter(vx, c.w);
+    float mis = rs_emitter_weight(rs_emitter_light_pdf(prim, dist, cosLight), vtx_at_pdf(vx, c.w));
+    c.value = surf_emission(prim) * scatter * (mis * cosLight / (dist * dist));
+    return true;
   }
   GpuLight l = lights[min(light, max(frame.lightCount, 1u) - 1u)];
 #else
   GpuLight l = lights[light];
 #endif
-  vec3 w;
-  float dist;
   vec3 Le;
-  if (!light_connect(l, vx.x, rs_decode_dir(ls), w, dist, Le)) return vec3(0.0f);
+  c.value = vec3(0.0f);
+  c.o = vx.x;
+  if (!light_connect(l, vx.x, rs_decode_dir(ls), c.w, c.reach, Le)) return false;
 #ifdef PLUME_HAS_SURFACES
-  vec3 o = vtx_at_origin(vx, w);
-  if (surf_occluded(o, w, dist)) return vec3(0.0f);
-  return Le * vtx_at_scatter(vx, w) * rs_transmittance(v, o, w, dist, unbiased, rng);
+  c.o = vtx_at_origin(vx, c.w);
+  c.value = Le * vtx_at_scatter(vx, c.w);
 #else
-  return Le * vtx_scatter(VERTEX_MEDIUM, w, vx.rayDir) * rs_transmittance(v, vx.x, w, dist, unbiased, rng);
+  c.value = Le * vtx_scatter(VERTEX_MEDIUM, c.w, vx.rayDir);
 #endif
+  return true;
+}
+
+// The light term at the path's last vertex vx: the connection's unshadowed term times the
+// transmittance along the light ray (and, with surfaces, its visibility).
+vec3 rs_light_term(uint v, PathVertex vx, uint light, vec2 ls, uint prim, bool unbiased, inout RngState rng) {
+  RsLightRay c;
+  if (!rs_light_connect(vx, light, ls, prim, c)) return vec3(0.0f);
+#ifdef PLUME_HAS_SURFACES
+  if (surf_occluded(c.o, c.w, c.reach)) return vec3(0.0f);
+#endif
+  return c.value * rs_transmittance(v, c.o, c.w, c.reach, unbiased, rng);
+}
+
+// A candidate vertex's light sample by resampled importance sampling (Talbot et al. 2005; the
+// light-sample step of ReSTIR DI, Bitterli et al. 2020): PLUME_RS_LIGHT_CANDIDATES samples from
+// rs_sample_light, one chosen in proportion to p̂_u / p_light with the unshadowed target
+// p̂_u = lum(f * connection term) (f: the path's throughput up to vx), which is positive wherever
+// the shadowed term is, so the chosen sample's contribution weight
+//   W = (1 / p̂_u(chosen)) * (1 / L) * sum_k p̂_u(l_k) / p_light(l_k)
+// is unbiased for 1 / (its density) (RIS; GRIS accepts it as a candidate's weight). One shadow
+// ray is then paid for the survivor alone (rs_light_term). Among thousands of small emitters
+// the unshadowed term's cosines and 1/d² find the lamps that face the vertex; with one light
+// of a fixed direction every sample is the same, and the host compiles L = 1. Returns W (0: no
+// sample with a nonzero term).
+float rs_resample_light(PathVertex vx, vec3 f, inout RngState rng, out uint light, out vec2 ls, out uint prim) {
+  float wSum = 0.0f;
+  float chosen = 0.0f;
+  light = 0u;
+  ls = vec2(0.0f);
+  prim = 0u;
+  for (uint k = 0u; k < uint(PLUME_RS_LIGHT_CANDIDATES); ++k) {
+    uvec4 h = rng_next4(rng);
+    uint lk;
+    vec2 lsk;
+    uint pk;
+    float pl = rs_sample_light(vx, vec3(rng_to_float(h.x), rng_to_float(h.y), rng_to_float(h.z)), rng, lk, lsk, pk);
+    RsLightRay c;
+    float ph = pl > 0.0f && rs_light_connect(vx, lk, lsk, pk, c) ? rs_luminance(f * c.value) : 0.0f;
+    float w = pl > 0.0f ? ph / pl : 0.0f;
+    if (!(w > 0.0f) || isinf(w)) continue;
+    wSum += w;
+    if (rng_to_float(h.w) * wSum < w) {
+      light = lk;
+      ls = lsk;
+      prim = pk;
+      chosen = ph;
+    }
+  }
+  return chosen > 0.0f ? wSum / (float(PLUME_RS_LIGHT_CANDIDATES) * chosen) : 0.0f;
 }
 
 // --- Path storage --------------------------------------------------------------------------------

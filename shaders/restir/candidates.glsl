@@ -1,8 +1,11 @@
 // Candidate paths (DESIGN §4.2 step 1). M random walks per pixel, each from its own uniform
 // position (u, v) in the pixel: each vertex's distance comes from coarse tracking in the mean
 // field (pdf sigma_c exp(-tau_c), closed form; volume/walk.glsl vol_mean_sample), each further
-// direction from the vertex's scattering (HG), and every vertex ends one candidate with a light chosen in proportion to its
-// estimated power (render/restir.cpp lightChoice). The candidate ending at vertex j of walk m
+// direction from the vertex's scattering (HG), and every vertex ends one candidate with a light
+// sample: a light chosen in proportion to its estimated power (render/restir.cpp lightChoice),
+// or, with PLUME_RS_LIGHT_CANDIDATES = L > 1 (render.restir_light_candidates), the survivor of L
+// such samples resampled by their unshadowed term (bridge.glsl rs_resample_light), whose RIS
+// weight W_light stands for 1 / p_light below. The candidate ending at vertex j of walk m
 // with light l is the path
 // (u, v, t1, w2, t2, ..., w_j, t_j, l, light sample) with source pdf
 //   p(y) = prod_i sigma_c(x_i) exp(-tau_i) * prod_{i>=2} phase_i * prod q (Russian roulette)
@@ -154,15 +157,23 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
 #ifdef RS_ENDS_IN_EMISSION
       if (j > maxVertices) break;  // no scattering beyond max_bounces
 #endif
-      uvec4 h = rng_next4(rng);
       uint light;
       vec2 ls;
       uint prim;
+#if PLUME_RS_LIGHT_CANDIDATES > 1
+      // L light samples resampled by their unshadowed term, one shadow ray (bridge.glsl)
+      float wLight = rs_resample_light(vx, f, rng, light, ls, prim);
+      float uSelect = rng_float(rng);
+#else
+      uvec4 h = rng_next4(rng);
       float pl = rs_sample_light(vx, vec3(rng_to_float(h.x), rng_to_float(h.y), rng_to_float(h.z)), rng, light, ls, prim);
-      if (pl > 0.0f) {
+      float wLight = pl > 0.0f ? 1.0f / pl : 0.0f;
+      float uSelect = rng_to_float(h.w);
+#endif
+      if (wLight > 0.0f) {
         float ph = rs_luminance(f * rs_light_term(VOL_CURRENT, vx, light, ls, prim, false, rng));
-        float weight = invM * ph / (pdf * pl);
-        if (rs_update(r, weight, ph, 0.0f, rng_to_float(h.w))) {
+        float weight = invM * ph * wLight / pdf;
+        if (rs_update(r, weight, ph, 0.0f, uSelect)) {
           head = rs_candidate_head(uv, t1, j, kinds, light, ls, prim);
           keep = j;
         }

@@ -121,6 +121,8 @@ RenderSettings withRestir(RenderSettings rs, const RestirOptions& v) {
   rs.restirRadius = v.radius;
   rs.restirRounds = v.rounds;
   rs.restirHistoryCap = v.historyCap;
+  rs.restirPrefix = v.prefix;
+  rs.restirLightCandidates = v.lightCandidates;
   return rs;
 }
 

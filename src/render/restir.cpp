@@ -14,7 +14,9 @@ namespace plume {
 std::string RestirOptions::name() const {
   const char* kind = mis == shared::RS_MIS_GBH ? "gbh" : mis == shared::RS_MIS_BIASED ? "biased" : "pairwise";
   // The prefix only when it is not the default, so the names of earlier benches still match.
-  const std::string k = prefix == RestirOptions{}.prefix ? "" : strf(" K%d", prefix);
+  // The light candidates likewise.
+  const std::string k = (prefix == RestirOptions{}.prefix ? "" : strf(" K%d", prefix)) +
+                        (lightCandidates == RestirOptions{}.lightCandidates ? "" : strf(" L%d", lightCandidates));
   if (rounds == 0) return strf("restir %s M%d R0 c%d%s", kind, candidates, historyCap, k.c_str());
   return strf("restir %s M%d k%d r%d R%d c%d%s", kind, candidates, neighbours, radius, rounds, historyCap, k.c_str());
 }
@@ -28,6 +30,7 @@ RestirOptions restirOptionsOf(const RenderSettings& rs) {
   o.historyCap = rs.restirHistoryCap;
   o.mis = rs.restirMis == "gbh" ? shared::RS_MIS_GBH : shared::RS_MIS_PAIRWISE;
   o.prefix = rs.restirPrefix;
+  o.lightCandidates = rs.restirLightCandidates;
   return o;
 }
 
@@ -109,6 +112,17 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   if (options_.neighbours > int(shared::RS_MAX_NEIGHBOURS)) {
     throw InputError(scene.path + strf(": render.restir_neighbours: at most %u", shared::RS_MAX_NEIGHBOURS));
   }
+  if (options_.lightCandidates < 1 || options_.lightCandidates > 64) {
+    throw InputError(scene.path + strf(": render.restir_light_candidates: expected 1 to 64 (got %d)", options_.lightCandidates));
+  }
+  // Light resampling (restir/bridge.glsl rs_resample_light) can only choose among light samples
+  // that differ in their unshadowed term: several lights, the emitters' points, a sky map's
+  // texels. One sun, one point light or a constant sky alone would draw L equal samples.
+  const bool manyLightSamples = features_.emitters || scene.lights.size() > 1 ||
+                                std::any_of(scene.lights.begin(), scene.lights.end(), [](const Light& l) {
+                                  return l.type == LightType::Environment && !l.map.empty();
+                                });
+  const int lightCandidates = manyLightSamples ? options_.lightCandidates : 1;
   using gpu::BindingType;
   // shaders/restir/bindings.glsl (numbers in shaders/shared/bindings.h)
   // Every binding in a table must be written before a dispatch (lavapipe reads them all): the
@@ -138,6 +152,7 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
     // 32x, shading 3.4 -> 5.9 ms; 16x is where the error stops falling (notes/restir.md).
     d.emplace_back("PLUME_RS_RESIDUAL_SCALE", "16.0f");
     d.emplace_back("PLUME_RS_MIS", std::to_string(options_.mis) + "u");
+    d.emplace_back("PLUME_RS_LIGHT_CANDIDATES", std::to_string(lightCandidates));
     d.insert(d.end(), extra.begin(), extra.end());
     return std::make_unique<gpu::ComputePass>(ctx, compiler.compile(file, d), bindings,
                                               uint32_t(sizeof(shared::RsPush)), name + variant, glm::uvec3(8, 8, 1));

@@ -29,6 +29,10 @@ const std::vector<SettingDesc>& renderSettingsTable() {
        &RenderSettings::restirHistoryCap, 0, 1000, {}},
       {"restir_mis", "ReSTIR: MIS weights for reuse: pairwise (O(k)) or gbh (generalised balance heuristic, O(k^2))",
        &RenderSettings::restirMis, 0, 0, {"pairwise", "gbh"}},
+      {"restir_light_candidates",
+       "ReSTIR: light samples drawn at each candidate vertex and resampled by their unshadowed contribution "
+       "before one shadow ray (1 = one light sample; only used with emissive surfaces, several lights or a sky map)",
+       &RenderSettings::restirLightCandidates, 1, 64, {}},
       {"restir_prefix",
        "ReSTIR: scattering vertices a reservoir's path holds (1-16, shared::RS_MAX_VERTICES); paths with more "
        "(up to max_bounces) are path traced in final shading",
