@@ -9,10 +9,12 @@
 #include "shaders/shared/bindings.h"
 #include "support/gpu_fixture.h"
 #include "support/grids.h"
+#include "support/light_tree.h"
 #include "support/scenes.h"
 
 #include <glm/glm.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -126,30 +128,54 @@ TEST_F(GpuSurfaceTest, ASceneWithoutSurfacesCompilesNoTraversal) {
   EXPECT_TRUE(PathTracer(ctx(), compiler(), with).hasSurfaces());
 }
 
-// The emitters' alias table chooses triangle i with probability w_i / sum w: the probability each
-// entry implies (its own keep, plus the rest of every entry that hands over to it, over n) equals
-// the weight's share, for spread, equal and one-dominant weights.
-TEST(EmitterAliasTable, ChoosesEachTriangleInProportionToItsWeight) {
+// The light tree (shared/light_tree.h, built by buildLightTree) over random emitters of every
+// orientation and size: at random shading points the probabilities of all emitters (lt_pmf, from
+// their trails) sum to at most 1, every emitter that faces
+// the point (at a corner or its centroid) has a nonzero probability (the importance bound is
+// conservative: a zero would be a bias), and the descent (lt_sample) returns the probability
+// lt_pmf gives its triangle. (CityEmitters.LightTree... checks the descent's frequencies.) Also for one emitter,
+// and for many emitters on one spot (a degenerate split).
+TEST(LightTree, ProbabilitiesSumToOneAndReachEveryEmitterThatFacesThePoint) {
   std::mt19937 gen(7);
-  std::uniform_real_distribution<double> logw(-3.0, 3.0);
-  std::vector<std::vector<double>> cases = {{}, std::vector<double>(50, 2.0), {1e6, 1.0, 1.0, 1.0}, {3.0}};
-  for (int i = 0; i < 1000; ++i) cases[0].push_back(std::pow(10.0, logw(gen)));
-  for (const std::vector<double>& w : cases) {
-    std::vector<uint32_t> triangles(w.size());
-    for (size_t i = 0; i < w.size(); ++i) triangles[i] = uint32_t(1000 + 3 * i);
-    const std::vector<shared::GpuEmitterAlias> table = emitterAliasTable(w, triangles);
-    ASSERT_EQ(table.size(), w.size());
-    std::vector<double> p(w.size(), 0.0);
-    for (size_t i = 0; i < table.size(); ++i) {
-      ASSERT_EQ(table[i].triangle, triangles[i]);
-      ASSERT_GE(table[i].keep, 0.0f);
-      ASSERT_LE(table[i].keep, 1.0f);
-      ASSERT_LT(table[i].alias, table.size());
-      p[i] += double(table[i].keep) / double(w.size());
-      p[table[i].alias] += (1.0 - double(table[i].keep)) / double(w.size());
+  std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+  auto point = [&](float r) { return r * glm::vec3(2.0f * u01(gen) - 1.0f, 2.0f * u01(gen) - 1.0f, 2.0f * u01(gen) - 1.0f); };
+  for (const int n : {1, 2, 3, 1000, 4096}) {
+    for (const bool onOneSpot : {false, true}) {
+      std::vector<LightTreeEmitter> e;
+      for (int i = 0; i < n; ++i) {
+        const glm::vec3 c = onOneSpot ? glm::vec3(0.5f) : point(4.0f);
+        const float size = std::pow(10.0f, -3.0f + 2.5f * u01(gen));
+        e.push_back({c + point(size), c + point(size), c + point(size), std::pow(10.0, 3.0 * u01(gen)), uint32_t(5 * i + 1)});
+      }
+      const LightTree tree = buildLightTree(e);
+      ASSERT_EQ(tree.nodes.size(), size_t(2 * n - 1));
+      EXPECT_LE(tree.depth, int(std::ceil(std::log2(double(n))))) << n;
+      test::ltTestNodes = &tree.nodes;
+      for (int k = 0; k < 200; ++k) {
+        const glm::vec3 x = point(6.0f);
+        double sum = 0.0;
+        bool anyFaces = false;
+        for (int i = 0; i < n; ++i) {
+          const float p = shared::lt_pmf(x, tree.trails[i]);
+          sum += p;
+          const glm::vec3 nrm = glm::cross(e[i].v1 - e[i].v0, e[i].v2 - e[i].v0);
+          const glm::vec3 c = (e[i].v0 + e[i].v1 + e[i].v2) / 3.0f;
+          bool faces = false;
+          for (const glm::vec3 q : {e[i].v0, e[i].v1, e[i].v2, c}) faces = faces || glm::dot(nrm, x - q) > 1e-6f * glm::length(nrm) * glm::length(x - q);
+          anyFaces = anyFaces || faces;
+          if (faces) EXPECT_GT(p, 0.0f) << "emitter " << i << " of " << n << " faces the point but cannot be picked";
+        }
+        // Below 1 where the descent can reach a node none of whose emitters faces x (it then
+        // returns no sample: nothing was lost that could light x).
+        EXPECT_LE(sum, 1.0 + 1e-4) << n;
+        const float u = u01(gen);
+        float pmf = 0.0f;
+        const uint32_t tri = shared::lt_sample(x, u, pmf);
+        if (!(pmf > 0.0f)) continue;
+        const auto it = std::find_if(e.begin(), e.end(), [&](const LightTreeEmitter& m) { return m.triangle == tri; });
+        ASSERT_NE(it, e.end());
+        EXPECT_NEAR(pmf, shared::lt_pmf(x, tree.trails[size_t(it - e.begin())]), 1e-5f * pmf);
+      }
     }
-    double total = 0.0;
-    for (double x : w) total += x;
-    for (size_t i = 0; i < w.size(); ++i) EXPECT_NEAR(p[i], w[i] / total, 1e-7 + 1e-6 * w[i] / total) << i << " of " << w.size();
   }
 }

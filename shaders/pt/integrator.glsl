@@ -71,23 +71,25 @@ vec3 pt_direct(PathVertex v, inout RngState rng) {
     sum += Le * scatter * tr * (mis / pdf);
   }
 #ifdef PLUME_HAS_EMITTERS
-  vec3 p;
-  vec3 n;
-  vec3 Le;
-  float pdfArea;
   uvec4 h = rng_next4(rng);
-  surf_sample_emitter(vec4(rng_to_float(h.x), rng_to_float(h.y), rng_to_float(h.z), rng_to_float(h.w)), p, n, Le,
-                      pdfArea);
-  vec3 toL = p - vtx_at_origin(v, p - v.x);
+  uint prim;
+  vec2 b;
+  float pdfArea = surf_sample_emitter_at(v.x, vec3(rng_to_float(h.x), rng_to_float(h.y), rng_to_float(h.z)), prim, b);
+  vec3 p = surf_triangle_point(prim, b);
+  vec3 o = vtx_at_origin(v, p - v.x);
+  vec3 toL = p - o;
   float dist = length(toL);
   vec3 w = toL / dist;
-  float cosLight = -dot(n, w);  // the back side emits nothing
+  float cosLight = -dot(surf_normal(prim), w);  // the back side emits nothing
   vec3 scatter = vtx_at_scatter(v, w);
-  if (dist > 0.0f && cosLight > 0.0f && any(greaterThan(scatter, vec3(0.0f)))) {
-    float pdf = pdfArea * dist * dist / cosLight;  // per solid angle at the vertex
+  if (pdfArea > 0.0f && dist > 0.0f && cosLight > 0.0f && any(greaterThan(scatter, vec3(0.0f)))) {
+    float g = dist * dist / cosLight;  // area to solid angle at the vertex
+    // The MIS weight with the light tree's density at the ray's origin, as pt_extend sees it
+    // when the vertex's own sampling hits the emitter (the same point for a medium vertex).
+    float pdfMis = (v.kind == VERTEX_MEDIUM ? pdfArea : surf_emitter_pdf_at(prim, o)) * g;
     // Stop short of the emitter's own triangle.
     float tr = pt_shadow(v, w, dist - surf_offset_length(p), rng);
-    sum += Le * scatter * (tr * pt_power_heuristic(pdf, vtx_at_pdf(v, w)) / pdf);
+    sum += surf_emission(prim) * scatter * (tr * pt_power_heuristic(pdfMis, vtx_at_pdf(v, w)) / (pdfArea * g));
   }
 #endif
   return sum;
@@ -165,7 +167,7 @@ bool pt_extend(uint slot, bool camera) {
     // After a vertex, weighted against that vertex's emitter sampling (its area density turned
     // into solid angle at the vertex: distance² / cosine).
     if (p.scatterings > 0u && any(greaterThan(le, vec3(0.0f)))) {
-      float pdfLight = surf_emitter_pdf(hit.prim) * hit.t * hit.t / abs(dot(n, p.dir));
+      float pdfLight = surf_emitter_pdf_at(hit.prim, p.origin) * hit.t * hit.t / abs(dot(n, p.dir));
       le *= pt_power_heuristic(p.phasePdf, pdfLight);
     }
 #endif

@@ -60,7 +60,7 @@ float rs_luminance(vec3 c) { return (c.x + c.y + c.z) * (1.0f / 3.0f); }
 // (lightChoice; render/restir.cpp), then light_sample_dir (at a surface vertex a constant
 // environment's direction by the BSDF's own sampling, as the path tracer's NEE). With emissive
 // surfaces the choice's entry GpuFrame.lightCount is "a point on the emitters": a triangle from
-// their alias table and a uniform point in it (prim, barycentrics in ls; four more draws from
+// the light tree at vx and a uniform point in it (prim, barycentrics in ls; four more draws from
 // rng, at every call). Returns the sample's pdf (the light's, at the stored direction, or per unit
 // area on the emitters, times the choice probability) or 0.
 float rs_sample_light(PathVertex vx, vec3 u, inout RngState rng, out uint light, out vec2 ls, out uint prim) {
@@ -73,9 +73,7 @@ float rs_sample_light(PathVertex vx, vec3 u, inout RngState rng, out uint light,
 #ifdef PLUME_HAS_EMITTERS
   uvec4 e = rng_next4(rng);
   if (light == frame.lightCount) {
-    prim = surf_pick_emitter(vec2(rng_to_float(e.x), rng_to_float(e.y)));
-    ls = surf_uniform_barycentrics(vec2(rng_to_float(e.z), rng_to_float(e.w)));
-    return pdf * surf_emitter_pdf(prim);
+    return pdf * surf_sample_emitter_at(vx.x, vec3(rng_to_float(e.x), rng_to_float(e.y), rng_to_float(e.z)), prim, ls);
   }
   GpuLight l = lights[min(light, max(frame.lightCount, 1u) - 1u)];  // (in range on every lane)
 #else
@@ -118,17 +116,19 @@ float rs_emitter_weight(float pdfThis, float pdfOther) {
   return pdfThis > 0.0f ? pdfThis * pdfThis / (pdfThis * pdfThis + pdfOther * pdfOther) : 0.0f;
 }
 
-float rs_emitter_light_pdf(uint prim, float dist, float cosLight) {
-  return lightChoice[frame.lightCount].probability * surf_emitter_pdf(prim) * dist * dist / cosLight;
+// The light samples' solid-angle density at the ray origin o (the vertex, pushed off a surface
+// towards the light: the point both ways of reaching the emitter agree on).
+float rs_emitter_light_pdf(uint prim, vec3 o, float dist, float cosLight) {
+  return lightChoice[frame.lightCount].probability * surf_emitter_pdf_at(prim, o) * dist * dist / cosLight;
 }
 
-// The emission of a hit on triangle prim at distance t along w from a vertex whose direction
-// sampling has density pdfDir there (vtx_at_pdf), with its MIS weight: the direction-sampling
-// part of an emitter's light.
-vec3 rs_emitter_hit(float pdfDir, uint prim, vec3 w, float t) {
+// The emission of a hit on triangle prim at distance t along w from the ray origin o of a vertex
+// whose direction sampling has density pdfDir there (vtx_at_pdf), with its MIS weight: the
+// direction-sampling part of an emitter's light.
+vec3 rs_emitter_hit(float pdfDir, uint prim, vec3 o, vec3 w, float t) {
   vec3 n = surf_normal(prim);
   vec3 Le = surf_emitted(prim, n, w);
-  float pl = rs_emitter_light_pdf(prim, t, abs(dot(n, w)));
+  float pl = rs_emitter_light_pdf(prim, o, t, abs(dot(n, w)));
   return Le * rs_emitter_weight(pdfDir, pl);
 }
 #endif
@@ -143,8 +143,8 @@ float rs_transmittance(uint v, vec3 x, vec3 w, float dist, bool unbiased, inout 
 // (o, pushed off a surface), its direction w and length `reach` (DDA_INF for distant lights; for
 // a point on an emissive triangle, short of the triangle itself), and the unshadowed light term
 // Le * scatter (for a point on an emissive triangle, per unit area: Le * scatter * cos_light / d²
-// with its MIS weight against direction sampling). False where it is 0 (the back of an emitter,
-// a direction outside the sun's disk).
+// with its MIS weight against direction sampling, unless !withMis). False where it is 0 (the back
+// of an emitter, a direction outside the sun's disk).
 struct RsLightRay {
   vec3 o;
   vec3 w;
@@ -152,7 +152,7 @@ struct RsLightRay {
   vec3 value;
 };
 
-bool rs_light_connect(PathVertex vx, uint light, vec2 ls, uint prim, out RsLightRay c) {
+bool rs_light_connect(PathVertex vx, uint light, vec2 ls, uint prim, bool withMis, out RsLightRay c) {
 #ifdef PLUME_HAS_EMITTERS
   if (light == frame.lightCount) {
     vec3 p = surf_triangle_point(prim, ls);
@@ -165,7 +165,7 @@ bool rs_light_connect(PathVertex vx, uint light, vec2 ls, uint prim, out RsLight
     c.value = vec3(0.0f);
     if (!(dist > 0.0f) || !(cosLight > 0.0f)) return false;
     vec3 scatter = vtx_at_scatter(vx, c.w);
-    float mis = rs_emitter_weight(rs_emitter_light_pdf(prim, dist, cosLight), vtx_at_pdf(vx, c.w));
+    float mis = withMis ? rs_emitter_weight(rs_emitter_light_pdf(prim, c.o, dist, cosLight), vtx_at_pdf(vx, c.w)) : 1.0f;
     c.value = surf_emission(prim) * scatter * (mis * cosLight / (dist * dist));
     return true;
   }
@@ -190,7 +190,7 @@ bool rs_light_connect(PathVertex vx, uint light, vec2 ls, uint prim, out RsLight
 // transmittance along the light ray (and, with surfaces, its visibility).
 vec3 rs_light_term(uint v, PathVertex vx, uint light, vec2 ls, uint prim, bool unbiased, inout RngState rng) {
   RsLightRay c;
-  if (!rs_light_connect(vx, light, ls, prim, c)) return vec3(0.0f);
+  if (!rs_light_connect(vx, light, ls, prim, true, c)) return vec3(0.0f);
 #ifdef PLUME_HAS_SURFACES
   if (surf_occluded(c.o, c.w, c.reach)) return vec3(0.0f);
 #endif
@@ -200,8 +200,9 @@ vec3 rs_light_term(uint v, PathVertex vx, uint light, vec2 ls, uint prim, bool u
 // A candidate vertex's light sample by resampled importance sampling (Talbot et al. 2005; the
 // light-sample step of ReSTIR DI, Bitterli et al. 2020): PLUME_RS_LIGHT_CANDIDATES samples from
 // rs_sample_light, one chosen in proportion to p̂_u / p_light with the unshadowed target
-// p̂_u = lum(f * connection term) (f: the path's throughput up to vx), which is positive wherever
-// the shadowed term is, so the chosen sample's contribution weight
+// p̂_u = lum(f * connection term) (f: the path's throughput up to vx; without the emitters' MIS
+// weight, which costs a second descent of the light tree), which is positive wherever the
+// shadowed term is, so the chosen sample's contribution weight
 //   W = (1 / p̂_u(chosen)) * (1 / L) * sum_k p̂_u(l_k) / p_light(l_k)
 // is unbiased for 1 / (its density) (RIS; GRIS accepts it as a candidate's weight). One shadow
 // ray is then paid for the survivor alone (rs_light_term). Among thousands of small emitters
@@ -221,7 +222,7 @@ float rs_resample_light(PathVertex vx, vec3 f, inout RngState rng, out uint ligh
     uint pk;
     float pl = rs_sample_light(vx, vec3(rng_to_float(h.x), rng_to_float(h.y), rng_to_float(h.z)), rng, lk, lsk, pk);
     RsLightRay c;
-    float ph = pl > 0.0f && rs_light_connect(vx, lk, lsk, pk, c) ? rs_luminance(f * c.value) : 0.0f;
+    float ph = pl > 0.0f && rs_light_connect(vx, lk, lsk, pk, false, c) ? rs_luminance(f * c.value) : 0.0f;
     float w = pl > 0.0f ? ph / pl : 0.0f;
     if (!(w > 0.0f) || isinf(w)) continue;
     wSum += w;
@@ -339,11 +340,12 @@ vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool unbiased, 
     }
 #endif
     float tr = rs_transmittance(D.v, x, w, t, unbiased, rng);
+    vec3 o = x;
     x += t * w;
 #ifdef PLUME_HAS_SURFACES
     if (kind == VERTEX_SURFACE) {
 #ifdef PLUME_HAS_EMITTERS
-      if (h.light == RS_LIGHT_EMITTER_HIT && i == n) return f * tr * rs_emitter_hit(vtx_at_pdf(prev, w), hit.prim, w, t);
+      if (h.light == RS_LIGHT_EMITTER_HIT && i == n) return f * tr * rs_emitter_hit(vtx_at_pdf(prev, w), hit.prim, o, w, t);
 #endif
       vec3 ng = surf_normal(hit.prim);
       vx = vtx_surface(x, w, hit.prim, surf_shading_normal(hit.prim, vec2(hit.u, hit.v), ng));

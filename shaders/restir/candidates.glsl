@@ -103,6 +103,7 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
         if (hit.prim == BVH_NONE) break;
         float trSurface = exp(-min(vol_mean_tau(VOL_CURRENT, x, w, hit.t), VOL_MAX_TAU));
         t = hit.t;
+        vec3 o = x;
         x += t * w;
         pdf *= trSurface;
         f *= trSurface;
@@ -112,7 +113,7 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
         // The candidate ending with the emitter this direction hits (its direction-sampling
         // part, rs_emitter_hit); a camera ray's hit is final shading's.
         if (j >= 2u) {
-          float ph = rs_luminance(f * rs_emitter_hit(vtx_at_pdf(prev, w), hit.prim, w, t));
+          float ph = rs_luminance(f * rs_emitter_hit(vtx_at_pdf(prev, w), hit.prim, o, w, t));
           if (rs_update(r, invM * ph / pdf, ph, 0.0f, rng_float(rng))) {
             head = rs_candidate_head(uv, t1, j, kinds, RS_LIGHT_EMITTER_HIT, vec2(0.0f), 0u);
             keep = j;

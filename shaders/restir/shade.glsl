@@ -93,7 +93,7 @@ bool rs_tail_segment(inout RsTail s, inout RngState rng) {
 #ifdef PLUME_HAS_EMITTERS
   // An emitter hit by the direction sampled at vertex j - 1 (its MIS part; the reservoirs hold
   // those of segments up to rs_emission_vertices).
-  if (!collided && hit.prim != BVH_NONE && j > emitting) s.L += s.beta * rs_emitter_hit(s.pdfDir, hit.prim, s.w, hit.t);
+  if (!collided && hit.prim != BVH_NONE && j > emitting) s.L += s.beta * rs_emitter_hit(s.pdfDir, hit.prim, s.x, s.w, hit.t);
 #endif
 #ifdef PLUME_HAS_SURFACES
   if (!collided && hit.prim == BVH_NONE) return false;

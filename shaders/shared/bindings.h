@@ -31,7 +31,7 @@ const uint BIND_BVH_NODES = 11u;       // BvhNode[]
 const uint BIND_BVH_TRIANGLES = 12u;   // BvhTriangle[]
 const uint BIND_SURF_TRIANGLES = 13u;  // GpuSurfaceTriangle[], by input index
 const uint BIND_SURF_MATERIALS = 14u;  // GpuSurfaceMaterial[], by surface
-const uint BIND_EMITTERS = 15u;        // GpuEmitterAlias[]: the emissive triangles' alias table
+const uint BIND_EMITTERS = 15u;        // GpuLightNode[]: the emissive triangles' light tree
 
 // ReSTIR (shaders/restir/bindings.glsl): its parameters, the current volume's mean field, the
 // previous frame's volume (temporal reuse evaluates the history's target with it), reservoirs.

@@ -1,7 +1,8 @@
 // The scene's surfaces as the estimators see them (DESIGN §2 "Surfaces", §4.3): the BVH's
 // bindings and traversal (surface/bvh.glsl), a hit's normals and material, emission leaving a
-// triangle's front side, the emissive triangles as one light sampled by area in proportion to
-// power (an alias table), and ray origins pushed off a surface. Compiled only into scenes with
+// triangle's front side, the emissive triangles as one light whose triangles a shading point picks
+// from the light tree (shared/light_tree.h: power, distance, orientation), and ray origins pushed
+// off a surface. Compiled only into scenes with
 // surfaces (PLUME_HAS_SURFACES; PLUME_HAS_EMITTERS where some surface emits). The host side is
 // render/gpu_surfaces.cpp; the CPU reference's own version is reference/surfaces.cpp.
 // Requires scene/bindings.glsl.
@@ -10,6 +11,7 @@
 
 #include "../shared/bvh.h"
 #include "../shared/surface_types.h"
+#include "../shared/light_tree.h"
 
 // The estimator's binding numbers may be shifted as a block (ReSTIR's passes use 11-15 for their
 // own buffers: shared/bindings.h BIND_RS_SURFACES); the path tracer's are BIND_BVH_NODES ...
@@ -25,7 +27,9 @@ layout(std430, binding = BIND_BVH_TRIANGLES + PLUME_SURF_BINDING_SHIFT) readonly
 layout(std430, binding = BIND_SURF_TRIANGLES + PLUME_SURF_BINDING_SHIFT) readonly buffer SurfTriangleBuffer { GpuSurfaceTriangle surfTriangles[]; };
 layout(std430, binding = BIND_SURF_MATERIALS + PLUME_SURF_BINDING_SHIFT) readonly buffer SurfMaterialBuffer { GpuSurfaceMaterial surfMaterials[]; };
 #ifdef PLUME_HAS_EMITTERS
-layout(std430, binding = BIND_EMITTERS + PLUME_SURF_BINDING_SHIFT) readonly buffer EmitterBuffer { GpuEmitterAlias surfEmitters[]; };
+layout(std430, binding = BIND_EMITTERS + PLUME_SURF_BINDING_SHIFT) readonly buffer LightTreeBuffer { GpuLightNode surfLightNodes[]; };
+#define LT_NODE(i) surfLightNodes[i]
+#include "../shared/light_tree.h"  // again, for the descent over surfLightNodes
 #endif
 
 const float SURF_FAR = 3.0e38f;
@@ -68,18 +72,7 @@ vec3 surf_offset_origin(vec3 p, vec3 n, vec3 w) {
 bool surf_occluded(vec3 o, vec3 d, float tMax) { return bvh_any(o, d, 0.0f, tMax); }
 
 #ifdef PLUME_HAS_EMITTERS
-// The area density with which surf_sample_emitter picks a point of triangle prim (0: it is dark).
-float surf_emitter_pdf(uint prim) { return surfTriangles[prim].lightPdf; }
-
-// An emissive triangle from the alias table (u: the table entry, its coin), chosen with
-// probability proportional to its power.
-uint surf_pick_emitter(vec2 u) {
-  uint i = min(uint(u.x * float(frame.emitterCount)), frame.emitterCount - 1u);
-  GpuEmitterAlias e = surfEmitters[i];
-  return u.y < e.keep ? e.triangle : surfEmitters[e.alias].triangle;
-}
-
-// A uniform point of triangle prim from u in [0,1)² (the square-root map, as the reference), as
+// A uniform point of a triangle from u in [0,1)² (the square-root map, as the reference), as
 // barycentrics (b1, b2) of v1 and v2.
 vec2 surf_uniform_barycentrics(vec2 u) {
   float r = sqrt(u.x);
@@ -93,14 +86,21 @@ vec3 surf_triangle_point(uint prim, vec2 b) {
 
 vec3 surf_emission(uint prim) { return surfMaterials[surfTriangles[prim].surface].emission; }
 
-// A point on the emissive triangles (u in [0,1)⁴: the table entry, its coin, then the point):
-// its position, front normal, radiance and area density.
-void surf_sample_emitter(vec4 u, out vec3 p, out vec3 n, out vec3 Le, out float pdfArea) {
-  uint prim = surf_pick_emitter(u.xy);
-  p = surf_triangle_point(prim, surf_uniform_barycentrics(u.zw));
-  n = surf_normal(prim);
-  Le = surf_emission(prim);
-  pdfArea = surf_emitter_pdf(prim);
+// A point on the emissive triangles for the shading point x (u in [0,1)³): a triangle from the
+// light tree (u.x), a uniform point in it (u.yz) as barycentrics. Returns its area density
+// (0: no emitter can light x).
+float surf_sample_emitter_at(vec3 x, vec3 u, out uint prim, out vec2 barycentrics) {
+  float pmf;
+  prim = lt_sample(x, u.x, pmf);
+  barycentrics = surf_uniform_barycentrics(u.yz);
+  return pmf > 0.0f ? pmf * surfTriangles[prim].emitterInvArea : 0.0f;
+}
+
+// The area density with which surf_sample_emitter_at(x) picks a point of triangle prim (0: it is
+// dark, or cannot light x).
+float surf_emitter_pdf_at(uint prim, vec3 x) {
+  GpuSurfaceTriangle t = surfTriangles[prim];
+  return t.emitterInvArea > 0.0f ? lt_pmf(x, t.lightTrail) * t.emitterInvArea : 0.0f;
 }
 #endif
 

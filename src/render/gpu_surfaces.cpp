@@ -28,31 +28,80 @@ gpu::Buffer upload(gpu::Context& ctx, const std::vector<T>& data, const char* na
 
 }  // namespace
 
-std::vector<shared::GpuEmitterAlias> emitterAliasTable(const std::vector<double>& weights,
-                                                const std::vector<uint32_t>& triangles) {
-  const size_t n = weights.size();
-  double total = 0.0;
-  for (double w : weights) total += w;
-  std::vector<double> scaled(n);
-  std::vector<size_t> small, large;
+LightTree buildLightTree(const std::vector<LightTreeEmitter>& emitters) {
+  LightTree tree;
+  const size_t n = emitters.size();
+  if (n == 0) return tree;
+  PLUME_CHECK(n < (size_t(1) << 30));
+  std::vector<glm::vec3> centroid(n), normal(n);
   for (size_t i = 0; i < n; ++i) {
-    scaled[i] = weights[i] / total * double(n);
-    (scaled[i] < 1.0 ? small : large).push_back(i);
+    const LightTreeEmitter& e = emitters[i];
+    centroid[i] = (e.v0 + e.v1 + e.v2) / 3.0f;
+    normal[i] = glm::normalize(glm::cross(e.v1 - e.v0, e.v2 - e.v0));
   }
-  std::vector<shared::GpuEmitterAlias> table(n);
-  for (size_t i = 0; i < n; ++i) table[i] = {1.0f, uint32_t(i), triangles[i], 0.0f};
-  while (!small.empty() && !large.empty()) {
-    const size_t s = small.back(), l = large.back();
-    small.pop_back();
-    table[s].keep = float(scaled[s]);
-    table[s].alias = uint32_t(l);
-    scaled[l] -= 1.0 - scaled[s];
-    if (scaled[l] < 1.0) {
-      large.pop_back();
-      small.push_back(l);
+  std::vector<uint32_t> order(n);
+  for (size_t i = 0; i < n; ++i) order[i] = uint32_t(i);
+  tree.trails.assign(n, 0u);
+  tree.nodes.reserve(2 * n - 1);
+  tree.nodes.emplace_back();
+  struct Task {
+    uint32_t node, begin, end, trail;
+    int depth;
+  };
+  std::vector<Task> stack{{0, 0, uint32_t(n), 1u, 0}};
+  while (!stack.empty()) {
+    const Task t = stack.back();
+    stack.pop_back();
+    shared::GpuLightNode nd{};
+    glm::vec3 lo(INFINITY), hi(-INFINITY), clo(INFINITY), chi(-INFINITY);
+    glm::dvec3 axis(0.0);
+    double power = 0.0;
+    for (uint32_t k = t.begin; k < t.end; ++k) {
+      const LightTreeEmitter& e = emitters[order[k]];
+      lo = glm::min(lo, glm::min(e.v0, glm::min(e.v1, e.v2)));
+      hi = glm::max(hi, glm::max(e.v0, glm::max(e.v1, e.v2)));
+      clo = glm::min(clo, centroid[order[k]]);
+      chi = glm::max(chi, centroid[order[k]]);
+      axis += glm::dvec3(normal[order[k]]);
+      power += e.power;
     }
+    nd.boxMin = lo;
+    nd.boxMax = hi;
+    nd.power = float(power);
+    // The cone: the normals' mean direction and the widest angle from it (a little wider, for the
+    // rounding of the shader's arithmetic); no direction where the normals cancel out.
+    const double len = glm::length(axis);
+    nd.axis = glm::vec3(0.0f, 0.0f, 1.0f);
+    nd.cosCone = -1.0f;
+    if (len > 1e-6 * double(t.end - t.begin)) {
+      nd.axis = glm::vec3(axis / len);
+      double cosMin = 1.0;
+      for (uint32_t k = t.begin; k < t.end; ++k) cosMin = std::min(cosMin, double(glm::dot(nd.axis, normal[order[k]])));
+      nd.cosCone = float(std::max(-1.0, cosMin - 1e-4));
+    }
+    tree.depth = std::max(tree.depth, t.depth);
+    if (t.end - t.begin == 1) {
+      nd.child = shared::LT_LEAF | emitters[order[t.begin]].triangle;
+      tree.trails[order[t.begin]] = t.trail;
+      tree.nodes[t.node] = nd;
+      continue;
+    }
+    const glm::vec3 ext = chi - clo;
+    const int ax = ext.x >= ext.y && ext.x >= ext.z ? 0 : ext.y >= ext.z ? 1 : 2;
+    const uint32_t mid = t.begin + (t.end - t.begin) / 2;
+    std::nth_element(order.begin() + t.begin, order.begin() + mid, order.begin() + t.end,
+                     [&](uint32_t a, uint32_t b) { return centroid[a][ax] < centroid[b][ax]; });
+    nd.child = uint32_t(tree.nodes.size());
+    tree.nodes[t.node] = nd;
+    tree.nodes.emplace_back();
+    tree.nodes.emplace_back();
+    // The children's trails: this node's turns, the child's turn at bit `depth`, the marker above.
+    const uint32_t turns = t.trail ^ (1u << t.depth);
+    const uint32_t marker = 1u << (t.depth + 1);
+    stack.push_back({nd.child, t.begin, mid, turns | marker, t.depth + 1});
+    stack.push_back({nd.child + 1, mid, t.end, turns | (1u << t.depth) | marker, t.depth + 1});
   }
-  return table;  // the entries left in either list keep themselves (probability 1, up to rounding)
+  return tree;
 }
 
 GpuSurfaces::GpuSurfaces(gpu::Context& ctx, const Scene& scene) {
@@ -70,9 +119,7 @@ GpuSurfaces::GpuSurfaces(gpu::Context& ctx, const Scene& scene) {
     materials.push_back(m);
   }
   std::vector<shared::GpuSurfaceTriangle> triangles(mesh.triangleCount());
-  std::vector<double> power;
-  std::vector<double> area;
-  std::vector<uint32_t> emitters;
+  std::vector<LightTreeEmitter> emitters;
   for (size_t i = 0; i < mesh.triangleCount(); ++i) {
     shared::GpuSurfaceTriangle& t = triangles[i];
     const glm::uvec3 v = mesh.triangles[i];
@@ -92,25 +139,24 @@ GpuSurfaces::GpuSurfaces(gpu::Context& ctx, const Scene& scene) {
     const double p = a * (double(le.x) + double(le.y) + double(le.z)) / 3.0;
     if (p > 0.0) {
       emitterSummary_.push_back({(t.v0 + t.v1 + t.v2) / 3.0f, glm::normalize(glm::cross(t.v1 - t.v0, t.v2 - t.v0)), p});
-      emitters.push_back(uint32_t(i));
-      power.push_back(p);
-      area.push_back(a);
+      emitters.push_back({t.v0, t.v1, t.v2, p, uint32_t(i)});
+      t.emitterInvArea = float(1.0 / a);
     }
   }
-  double total = 0.0;
-  for (double p : power) total += p;
-  for (size_t k = 0; k < emitters.size(); ++k) triangles[emitters[k]].lightPdf = float(power[k] / total / area[k]);
+  const LightTree lightTree = buildLightTree(emitters);
+  for (size_t k = 0; k < emitters.size(); ++k) triangles[emitters[k].triangle].lightTrail = lightTree.trails[k];
   emitterCount_ = uint32_t(emitters.size());
+  lightTreeDepth_ = lightTree.depth;
 
   nodes_ = upload(ctx, bvh.nodes, "BVH nodes");
   bvhTriangles_ = upload(ctx, bvh.triangles, "BVH triangles");
   triangles_ = upload(ctx, triangles, "surface triangles");
   materials_ = upload(ctx, materials, "surface materials");
-  emitters_ = upload(ctx, emitters.empty() ? std::vector<shared::GpuEmitterAlias>{} : emitterAliasTable(power, emitters),
-                     "emitter table");
+  emitters_ = upload(ctx, lightTree.nodes, "light tree");
   uploadMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  logInfo(strf("surfaces: %zu triangles (%u emissive), BVH %zu nodes, %.1f bytes/triangle on the device; built in %.0f ms",
-               mesh.triangleCount(), emitterCount_, stats_.nodes, stats_.bytesPerTriangle(), stats_.buildMs));
+  logInfo(strf("surfaces: %zu triangles (%u emissive, light tree depth %d), BVH %zu nodes, %.1f bytes/triangle on the "
+               "device; built in %.0f ms",
+               mesh.triangleCount(), emitterCount_, lightTreeDepth_, stats_.nodes, stats_.bytesPerTriangle(), stats_.buildMs));
 }
 
 void GpuSurfaces::bind(gpu::DescriptorSet& set, uint32_t shift) const {

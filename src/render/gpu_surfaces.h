@@ -1,13 +1,14 @@
 // The scene's surfaces on the device (DESIGN §4.3; shaders/surface/surfaces.glsl): the triangles
 // loaded and transformed (geometry/scene_mesh.h), Embree's BVH flattened (geometry/bvh.h), each
-// input triangle's vertices, shading normals, surface and light density, the surfaces' materials,
-// and an alias table over the emissive triangles (chosen in proportion to power: area times the
-// mean of Le's channels, as the CPU reference). Built only for scenes with surfaces.
+// input triangle's vertices, shading normals, surface and place in the light tree, the surfaces'
+// materials, and the light tree over the emissive triangles (a shading point picks them by their
+// power, distance and orientation: shaders/shared/light_tree.h). Built only for scenes with surfaces.
 #pragma once
 
 #include "geometry/bvh.h"
 #include "gpu/pipeline.h"
 #include "scene/scene.h"
+#include "shaders/shared/light_tree.h"
 #include "shaders/shared/surface_types.h"
 
 #include <cstdint>
@@ -15,11 +16,21 @@
 
 namespace plume {
 
-// Walker's alias table (Vose's construction, in double) over weights w_i > 0, entry i naming
-// triangles[i]: surface/surfaces.glsl picks entry i with probability 1/n and keeps it with
-// probability keep, else takes entry alias, so triangle i is chosen with probability w_i / sum w.
-std::vector<shared::GpuEmitterAlias> emitterAliasTable(const std::vector<double>& weights,
-                                                       const std::vector<uint32_t>& triangles);
+// The light tree over the emissive triangles (shaders/shared/light_tree.h): nodes[0] is the root,
+// the children of an inner node are adjacent, and trails[i] is emitter i's path from the root
+// (lt_pmf's encoding). Built by splitting at the median centroid along the longest axis of the
+// centroids' box, so its depth is ceil(log2 n) (at most 30: n < 2^30).
+struct LightTreeEmitter {
+  glm::vec3 v0, v1, v2;
+  double power;       // area times mean(Le)
+  uint32_t triangle;  // input index
+};
+struct LightTree {
+  std::vector<shared::GpuLightNode> nodes;
+  std::vector<uint32_t> trails;
+  int depth = 0;
+};
+LightTree buildLightTree(const std::vector<LightTreeEmitter>& emitters);
 
 class GpuSurfaces {
  public:
@@ -35,11 +46,13 @@ class GpuSurfaces {
   double emitterPowerAt(glm::vec3 p) const;
   uint32_t emitterCount() const { return emitterCount_; }
   const geo::BvhStats& bvhStats() const { return stats_; }
+  int lightTreeDepth() const { return lightTreeDepth_; }
   double uploadMs() const { return uploadMs_; }
 
  private:
   gpu::Buffer nodes_, bvhTriangles_, triangles_, materials_, emitters_;
   uint32_t emitterCount_ = 0;
+  int lightTreeDepth_ = 0;
   struct EmitterSummary {
     glm::vec3 centroid, normal;
     double power;  // area times mean(Le)

@@ -28,7 +28,7 @@ struct RenderSettings {
   int restirHistoryCap = 20;         // temporal confidence cap c: M_hist <= c * M_cur (0 = no temporal)
   std::string restirMis = "pairwise";  // pairwise | gbh (generalised balance heuristic)
   int restirPrefix = 16;             // path vertices a reservoir holds; longer paths: a path-traced tail
-  int restirLightCandidates = 8;     // light samples resampled at each candidate vertex (RIS)
+  int restirLightCandidates = 2;     // light samples resampled at each candidate vertex (RIS)
 };
 
 struct SettingDesc {

@@ -21,6 +21,7 @@
 #include "shared/bsdf.h"
 #include "shared/pt_wave.h"
 #include "shared/surface_types.h"
+#include "shared/light_tree.h"
 
 // restir_mis.h reads its inputs through accessor macros (here: small tables).
 float misM[3];
@@ -165,9 +166,15 @@ void main() {
   GpuSurfaceMaterial material;
   material.bsdf = bsdf;
   material.emission = vec3(PT_PATH_BYTES);
-  GpuEmitterAlias alias;
-  alias.keep = material.emission.x;
-  t += alias.keep + material.bsdf.alpha;
+  // light_tree.h
+  GpuLightNode node;
+  node.boxMin = vec3(-1.0f);
+  node.boxMax = vec3(1.0f);
+  node.power = material.emission.x;
+  node.axis = vec3(0.0f, 0.0f, 1.0f);
+  node.cosCone = 0.5f;
+  node.child = LT_LEAF;
+  t += lt_importance(node, wo + vec3(3.0f)) + lt_first_child_probability(1.0f, 2.0f) + material.bsdf.alpha;
   values[i] = vec4(s + wo, t + m + (picked ? 1.0f : 0.0f) + (dropped ? 2.0f : 0.0f) +
                    (rs_is_finite(back.W) ? back.W : 0.0f));
 }
