@@ -9,13 +9,6 @@
 
 namespace plume {
 
-void checkGpuSupports(const Scene& scene, const std::string& renderer, bool rendersSurfaces) {
-  if (!rendersSurfaces && !scene.surfaces.empty()) {
-    throw InputError(scene.path + ": surfaces: " + renderer +
-                     " does not render surfaces yet (issue 12): use --mode pt, or plume reference");
-  }
-}
-
 std::vector<shared::GpuLight> gpuLights(const Scene& scene) {
   std::vector<shared::GpuLight> out;
   for (const Light& l : scene.lights) {

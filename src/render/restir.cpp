@@ -89,7 +89,6 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
                bool kernelCounters)
     : ctx_(ctx), scene_(scene), options_(options), features_(featuresOf(scene)), timer_(ctx, 32) {
   features_.kernelCounters = kernelCounters;
-  checkGpuSupports(scene, "ReSTIR", true);
   envMap_ = std::make_unique<GpuEnvironmentMap>(ctx, scene);  // bad maps fail before compiling
   if (features_.surfaces) surfaces_ = std::make_unique<GpuSurfaces>(ctx, scene);
   if (options_.prefix < 1 || options_.prefix > int(shared::RS_MAX_VERTICES)) {
