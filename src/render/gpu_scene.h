@@ -21,8 +21,8 @@ shared::GpuCamera gpuCamera(const Camera& cam, int frame);
 bool sameCamera(const shared::GpuCamera& a, const shared::GpuCamera& b);  // every field but the padding
 
 // GpuFrame of `frame`: camera, medium, image size, bounces and light count from the scene;
-// the random-stream seed and frame key, and the samples per dispatch, from the caller.
-shared::GpuFrame gpuFrame(const Scene& scene, int frame, uint32_t seed, uint32_t frameKey, uint32_t sppPerDispatch);
+// the random-stream seed and frame key from the caller.
+shared::GpuFrame gpuFrame(const Scene& scene, int frame, uint32_t seed, uint32_t frameKey);
 
 // A progressive accumulation buffer (per pixel: vec4(mean rgb, n), vec4(M2 rgb, 0), Welford's
 // update on the GPU) read back as the mean and the variance of the mean.

@@ -94,7 +94,7 @@ void PathTracer::setVolume(const GpuVolumeResources& volume) {
 }
 
 void PathTracer::beginFrame(int frame) {
-  frame_ = gpuFrame(scene_, frame, uint32_t(scene_.render.seed), uint32_t(frame), 1u);
+  frame_ = gpuFrame(scene_, frame, uint32_t(scene_.render.seed), uint32_t(frame));
   frame_.emitterCount = surfaces_ ? surfaces_->emitterCount() : 0u;
   accum_.fillZero();
   samples_ = 0;

@@ -228,7 +228,7 @@ std::vector<gpu::ComputePass*> Restir::passes() const {
 void Restir::resetHistory() { hasHistory_ = false; }
 
 void Restir::fillFrame(int frame, uint32_t sequence, uint32_t key) {
-  frame_ = gpuFrame(scene_, frame, uint32_t(scene_.render.seed) + 0x9E3779B9u * sequence, key, 1u);
+  frame_ = gpuFrame(scene_, frame, uint32_t(scene_.render.seed) + 0x9E3779B9u * sequence, key);
   frame_.emitterCount = surfaces_ ? surfaces_->emitterCount() : 0u;
   const shared::GpuCamera& cam = frame_.camera;
   const bool history = hasHistory_ && options_.historyCap > 0 && prevSequence_ == sequence;
