@@ -24,6 +24,7 @@
 #include "../surface/surfaces.glsl"
 #endif
 #include "../integrator/vertex.glsl"
+#include "../integrator/path.glsl"
 
 // Transmittance times visibility from the vertex along w over (0, dist): ratio tracking, and
 // any surface in between blocks the light.
@@ -136,48 +137,36 @@ bool pt_extend(uint slot, bool camera) {
     p = ptPaths[slot];
     rng.counter = p.counter;
   }
-  float tMax = DDA_INF;
-#ifdef PLUME_HAS_SURFACES
-  BvhHit hit = bvh_closest(p.origin, p.dir, 0.0f, SURF_FAR);
-  if (hit.prim != BVH_NONE) tMax = hit.t;
-#endif
-  float t;
-  bool collided;
+  PathSegment seg = path_segment(p.origin, p.dir, rng);
 #ifdef PLUME_HAS_EMISSION
-  vec3 emitted;
-  collided = vol_sample_collision_emitting(p.origin, p.dir, tMax, rng, t, emitted);
   // Emission along this segment: a path of `scatterings` scattering vertices, counted up to
   // max_bounces like next-event estimation's (pbrt-v4's volpath does the same).
-  p.radiance += p.beta * (vec3(1.0f) - vtx_albedo(VERTEX_MEDIUM)) * emitted;
-#else
-  collided = vol_sample_collision(p.origin, p.dir, tMax, rng, t);
+  p.radiance += path_emission(seg, p.beta);
 #endif
-  bool vertex = collided;
-  if (collided) {
-    p.origin += t * p.dir;
-    p.beta *= vtx_albedo(VERTEX_MEDIUM);  // delta tracking's collision weight
-    p.prim = PT_MEDIUM_VERTEX;
-  }
-#ifdef PLUME_HAS_SURFACES
-  else if (hit.prim != BVH_NONE) {
-    vertex = true;
-    vec3 n = surf_normal(hit.prim);
-    vec3 le = surf_emitted(hit.prim, n, p.dir);
+  bool vertex = path_has_vertex(seg);
+  if (vertex) {
 #ifdef PLUME_HAS_EMITTERS
-    // After a vertex, weighted against that vertex's emitter sampling (its area density turned
-    // into solid angle at the vertex: distance² / cosine).
-    if (p.scatterings > 0u && any(greaterThan(le, vec3(0.0f)))) {
-      float pdfLight = surf_emitter_pdf_at(hit.prim, p.origin) * hit.t * hit.t / abs(dot(n, p.dir));
-      le *= pt_power_heuristic(p.phasePdf, pdfLight);
+    vec3 origin = p.origin;  // the ray's, before it moves to the vertex
+#endif
+    PathVertex v = path_vertex(seg, p.origin, p.dir, p.beta);
+    p.prim = PT_MEDIUM_VERTEX;
+#ifdef PLUME_HAS_SURFACES
+    if (v.kind == VERTEX_SURFACE) {
+      vec3 le = surf_emitted(v.prim, v.n, p.dir);
+#ifdef PLUME_HAS_EMITTERS
+      // After a vertex, weighted against that vertex's emitter sampling (its area density turned
+      // into solid angle at the vertex: distance² / cosine), the light tree's at the ray's origin.
+      if (p.scatterings > 0u && any(greaterThan(le, vec3(0.0f)))) {
+        float pdfLight = surf_emitter_pdf_at(v.prim, origin) * seg.t * seg.t / abs(dot(v.n, p.dir));
+        le *= pt_power_heuristic(p.phasePdf, pdfLight);
+      }
+#endif
+      p.radiance += p.beta * le;
+      p.prim = v.prim;
+      p.shading = v.ns;
     }
 #endif
-    p.radiance += p.beta * le;
-    p.origin += hit.t * p.dir;
-    p.prim = hit.prim;
-    p.shading = surf_shading_normal(hit.prim, vec2(hit.u, hit.v), n);
-  }
-#endif
-  else {
+  } else {
     // Camera rays see every environment; after a vertex, only a map is seen (with its MIS
     // weight): the other lights are reached by NEE.
     if (p.scatterings == 0u) p.radiance += p.beta * light_escaped(p.dir);
@@ -210,25 +199,9 @@ bool pt_shade(uint slot) {
   p.radiance += p.beta * pt_direct(v, rng);
   bool more = false;
 #ifdef PT_FOLLOWS_PHASE
-  more = true;
-  if (p.scatterings >= frame.rrStartBounce) {
-    float q = min(1.0f, plume_max3(p.beta));
-    if (rng_float(rng) >= q) {
-      more = false;
-    } else {
-      p.beta /= q;
-    }
-  }
-  if (more) {
-    vec3 next;
-    float pdf;
-    vec3 weight = vtx_at_sample(v, rng_float2(rng), next, pdf);
-    more = pdf > 0.0f;  // (a BSDF that produced no direction ends the path)
-    p.beta *= weight;
-    p.phasePdf = pdf;
-    p.origin = vtx_at_origin(v, next);
-    p.dir = next;
-  }
+  // Roulette on the throughput; a BSDF that produced no direction also ends the path.
+  more = path_roulette(p.scatterings, min(1.0f, plume_max3(p.beta)), rng, p.beta) &&
+         path_scatter(v, rng_float2(rng), p.beta, p.origin, p.dir, p.phasePdf);
 #endif
   p.counter = rng.counter;
   ptPaths[slot] = p;

@@ -206,9 +206,9 @@ vec3 rs_light_term(uint v, PathVertex vx, uint light, vec2 ls, uint prim, bool u
 //   W = (1 / p̂_u(chosen)) * (1 / L) * sum_k p̂_u(l_k) / p_light(l_k)
 // is unbiased for 1 / (its density) (RIS; GRIS accepts it as a candidate's weight). One shadow
 // ray is then paid for the survivor alone (rs_light_term). Among thousands of small emitters
-// the unshadowed term's cosines and 1/d² find the lamps that face the vertex; with one light
-// of a fixed direction every sample is the same, and the host compiles L = 1. Returns W (0: no
-// sample with a nonzero term).
+// the unshadowed term's cosines and 1/d² find the lamps that face the vertex; the host compiles
+// L > 1 with emissive surfaces only (render/restir.cpp says why). Returns W (0: no sample with a
+// nonzero term).
 float rs_resample_light(PathVertex vx, vec3 f, inout RngState rng, out uint light, out vec2 ls, out uint prim) {
   float wSum = 0.0f;
   float chosen = 0.0f;

@@ -11,6 +11,8 @@
 #include "../shared/accumulate.h"
 
 #ifdef PLUME_RS_TAIL
+#include "../integrator/path.glsl"
+
 // The tail (notes/restir.md "Any path length"): an independent path-traced estimate of the
 // paths with more than K = rsp.prefixVertices scattering vertices (up to frame.maxBounces).
 // Reservoirs only ever hold paths of at most K vertices, each ending in a light sample at its last
@@ -64,60 +66,33 @@ RsTail rs_tail_start(RsDomain D, vec3 shaded, inout RngState rng) {
   return RsTail(D.origin, 1u, w, rng.counter, vec3(1.0f), 0.0f, vec3(0.0f), shaded);
 }
 
-// Segment s.j of the walk and what its vertex adds; false when the walk ends there. With
+// Segment s.j of the walk and what its vertex adds; false when the walk ends there. The segment
+// and the scattering at its vertex are the path tracer's steps (integrator/path.glsl): with
 // surfaces the segment ends at the nearer of the medium's collision and the first surface, a
-// vertex either way (the path tracer's rule): NEE at either, BSDF sampling at a surface (weight
-// f cos / pdf), and emitters reached both ways with the reservoirs' MIS weights
-// (rs_emitter_weight).
+// vertex either way; NEE at either, BSDF sampling at a surface (weight f cos / pdf), and emitters
+// reached both ways with the reservoirs' MIS weights (rs_emitter_weight).
 bool rs_tail_segment(inout RsTail s, inout RngState rng) {
   uint j = s.j;
-  float tMax = DDA_INF;
-#ifdef PLUME_HAS_SURFACES
-  BvhHit hit = bvh_closest(s.x, s.w, 0.0f, SURF_FAR);
-  if (hit.prim != BVH_NONE) tMax = hit.t;
-#endif
 #ifdef RS_ENDS_IN_EMISSION
   uint emitting = rs_emission_vertices();
   uint segments = frame.maxBounces + 1u;
 #else
   uint segments = frame.maxBounces;
 #endif
-  float t;
+  PathSegment seg = path_segment(s.x, s.w, rng);
 #ifdef PLUME_HAS_EMISSION
-  vec3 emitted;
-  bool collided = vol_sample_collision_emitting(s.x, s.w, tMax, rng, t, emitted);
-  if (j > emitting) s.L += s.beta * (vec3(1.0f) - vtx_albedo(VERTEX_MEDIUM)) * emitted;
-#else
-  bool collided = vol_sample_collision(s.x, s.w, tMax, rng, t);
+  if (j > emitting) s.L += path_emission(seg, s.beta);
 #endif
 #ifdef PLUME_HAS_EMITTERS
   // An emitter hit by the direction sampled at vertex j - 1 (its MIS part; the reservoirs hold
   // those of segments up to rs_emission_vertices).
-  if (!collided && hit.prim != BVH_NONE && j > emitting) s.L += s.beta * rs_emitter_hit(s.pdfDir, hit.prim, s.x, s.w, hit.t);
+  if (path_hits_surface(seg) && j > emitting) s.L += s.beta * rs_emitter_hit(s.pdfDir, seg.hit.prim, s.x, s.w, seg.t);
 #endif
-#ifdef PLUME_HAS_SURFACES
-  if (!collided && hit.prim == BVH_NONE) return false;
-#else
-  if (!collided) return false;
-#endif
+  if (!path_has_vertex(seg)) return false;
 #ifdef RS_ENDS_IN_EMISSION
   if (j > frame.maxBounces) return false;
 #endif
-#ifdef PLUME_HAS_SURFACES
-  PathVertex vx;
-  if (collided) {
-    s.x += t * s.w;
-    s.beta *= vtx_albedo(VERTEX_MEDIUM);
-    vx = vtx_medium(s.x, s.w);
-  } else {
-    s.x += hit.t * s.w;
-    vx = vtx_surface(s.x, s.w, hit.prim, surf_shading_normal(hit.prim, vec2(hit.u, hit.v), surf_normal(hit.prim)));
-  }
-#else
-  s.x += t * s.w;
-  s.beta *= vtx_albedo(VERTEX_MEDIUM);
-  PathVertex vx = vtx_medium(s.x, s.w);
-#endif
+  PathVertex vx = path_vertex(seg, s.x, s.w, s.beta);
   if (j > rsp.prefixVertices) {
     uvec4 h = rng_next4(rng);
     uint light;
@@ -127,20 +102,15 @@ bool rs_tail_segment(inout RsTail s, inout RngState rng) {
     if (pl > 0.0f) s.L += s.beta * rs_light_term(VOL_CURRENT, vx, light, ls, prim, true, rng) / pl;
   }
   if (j == segments) return false;
-  if (j >= frame.rrStartBounce) {
-    float q = min(1.0f, plume_max3(vtx_albedo(VERTEX_MEDIUM)));
-    if (rng_float(rng) >= q) return false;
-    s.beta /= q;
-  }
+  // The candidates' roulette: on the albedo, not the throughput.
+  if (!path_roulette(j, min(1.0f, plume_max3(vtx_albedo(VERTEX_MEDIUM))), rng, s.beta)) return false;
 #ifdef PLUME_HAS_SURFACES
-  vec3 wNext;
-  float pdfDir;
-  s.beta *= vtx_at_sample(vx, rng_float2(rng), wNext, pdfDir);
-  if (!(pdfDir > 0.0f)) return false;
-  s.pdfDir = vtx_at_pdf(vx, wNext);
-  s.x = vtx_at_origin(vx, wNext);
-  s.w = wNext;
+  float pdf;
+  if (!path_scatter(vx, rng_float2(rng), s.beta, s.x, s.w, pdf)) return false;
+  s.pdfDir = vtx_at_pdf(vx, s.w);  // evaluated as the reservoirs' emitter hits evaluate it
 #else
+  // The phase's sample as such (vtx_at_sample normalises it once more, and evaluates a pdf the
+  // walk has no use for without emitters).
   s.w = vtx_sample(VERTEX_MEDIUM, s.w, rng_float2(rng));
 #endif
   s.j = j + 1u;

@@ -98,7 +98,6 @@ struct GpuFrame {
   vec3 albedo;           // the medium's single-scattering albedo
   float g;               // its Henyey-Greenstein asymmetry
   uvec2 size;            // image width, height
-  uint spp;              // samples per pixel of this dispatch (path tracer)
   uint maxBounces;
   uint seed;             // render seed (random streams)
   uint frameKey;         // frame (and iteration) key of the random streams
@@ -108,6 +107,7 @@ struct GpuFrame {
   uint loopProbe;        // 2: the trip count of the driver-loop-limit probe (volume/loop_guard.glsl)
   uint emitterCount;     // entries of the emissive triangles' alias table (surface/surfaces.glsl)
   uint pad2;
+  uint pad3;
 };
 
 // The pinhole camera's (un-normalised) direction through image position p, in pixels from the
@@ -136,7 +136,9 @@ static_assert(offsetof(plume::shared::GpuEnvMap, width) == 48, "GpuEnvMap layout
 static_assert(sizeof(plume::shared::GpuCamera) == 64, "GpuCamera layout");
 static_assert(offsetof(plume::shared::GpuFrame, albedo) == 64, "GpuFrame layout");
 static_assert(offsetof(plume::shared::GpuFrame, size) == 80, "GpuFrame layout");
-static_assert(offsetof(plume::shared::GpuFrame, seed) == 96, "GpuFrame layout");
+static_assert(offsetof(plume::shared::GpuFrame, maxBounces) == 88, "GpuFrame layout");
+static_assert(offsetof(plume::shared::GpuFrame, seed) == 92, "GpuFrame layout");
+static_assert(offsetof(plume::shared::GpuFrame, emitterCount) == 116, "GpuFrame layout");
 static_assert(sizeof(plume::shared::GpuFrame) == 8 * 16, "GpuFrame layout");
 #endif
 

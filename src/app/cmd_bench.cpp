@@ -5,7 +5,6 @@
 #include "app/settings_cli.h"
 #include "core/error.h"
 #include "core/log.h"
-#include "render/gpu_scene.h"
 #include "bench/bench.h"
 #include "bench/kernels.h"
 
@@ -39,7 +38,10 @@ int runBenchCommand(const BenchArgs& a) {
   Scene scene = loadScene(a.scene);
   // The kernel table's event counters cover the volume walks only (not the surfaces' traversal);
   // the error-against-time bench measures every estimator with surfaces.
-  if (a.kernels) checkGpuSupports(scene, "bench --kernels", false);
+  if (a.kernels && !scene.surfaces.empty()) {
+    throw InputError(scene.path + ": surfaces: bench --kernels measures the volume walks only and takes no "
+                     "surfaces: use plume bench without --kernels, or a scene without surfaces");
+  }
   applyOverrides(scene.render, a.overrides);
   if (a.width > 0) scene.camera.width = a.width;
   if (a.height > 0) scene.camera.height = a.height;

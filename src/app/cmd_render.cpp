@@ -10,7 +10,6 @@
 #include "media/bake.h"
 #include "media/volume_frames.h"
 #include "render/estimator.h"
-#include "render/gpu_scene.h"
 #include "render/volume_source.h"
 #include "scene/scene.h"
 
@@ -112,7 +111,6 @@ int runRender(const RenderArgs& a) {
   Scene scene = loadJobScene(a);
   const RenderSettings& rs = scene.render;
   const EstimatorKind kind = estimatorKind(rs);
-  checkGpuSupports(scene, "--mode " + rs.mode, true);  // before any output
   const EstimatorTraits& traits = estimatorTraits(kind);
   if (a.preroll > 0 && !traits.carriesHistory) {
     logInfo(strf("--preroll %d: no effect with mode %s (its frames are independent)", a.preroll, rs.mode.c_str()));

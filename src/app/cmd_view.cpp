@@ -5,7 +5,6 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "render/estimator.h"
-#include "render/gpu_scene.h"
 #include "viewer/viewer.h"
 
 #include <memory>
@@ -24,10 +23,6 @@ int runView(ViewArgs& a) {
   setQuiet(a.options.quiet);
   Scene scene = loadScene(a.scene);
   applyOverrides(scene.render, a.overrides);
-  // Every estimator renders surfaces (the path tracer and ReSTIR); a mode that did not would be
-  // refused here, and switching to it in the panel would show the same message and stay with the
-  // path tracer (Viewer::rebuildRenderer).
-  checkGpuSupports(scene, "--mode " + scene.render.mode, true);
   if (a.width > 0) scene.camera.width = a.width;
   if (a.height > 0) scene.camera.height = a.height;
   if (scene.media.empty()) throw InputError(scene.path + ": media: the viewer needs a medium");

@@ -9,13 +9,6 @@
 
 namespace plume {
 
-void checkGpuSupports(const Scene& scene, const std::string& renderer, bool rendersSurfaces) {
-  if (!rendersSurfaces && !scene.surfaces.empty()) {
-    throw InputError(scene.path + ": surfaces: " + renderer +
-                     " does not render surfaces yet (issue 12): use --mode pt, or plume reference");
-  }
-}
-
 std::vector<shared::GpuLight> gpuLights(const Scene& scene) {
   std::vector<shared::GpuLight> out;
   for (const Light& l : scene.lights) {
@@ -71,7 +64,7 @@ bool sameCamera(const shared::GpuCamera& a, const shared::GpuCamera& b) {
          a.aspect == b.aspect && a.right == b.right && a.up == b.up;
 }
 
-shared::GpuFrame gpuFrame(const Scene& scene, int frame, uint32_t seed, uint32_t frameKey, uint32_t sppPerDispatch) {
+shared::GpuFrame gpuFrame(const Scene& scene, int frame, uint32_t seed, uint32_t frameKey) {
   const Camera& cam = scene.camera;
   const Medium& m = scene.medium();
   const RenderSettings& rs = scene.render;
@@ -80,7 +73,6 @@ shared::GpuFrame gpuFrame(const Scene& scene, int frame, uint32_t seed, uint32_t
   f.albedo = m.albedo;
   f.g = m.g;
   f.size = glm::uvec2(uint32_t(cam.width), uint32_t(cam.height));
-  f.spp = sppPerDispatch;
   f.maxBounces = uint32_t(rs.maxBounces);
   f.seed = seed;
   f.frameKey = frameKey;

@@ -1,6 +1,6 @@
 // The scene as the GPU estimators see it: lights and camera vectors in the shared GPU layout
-// (shaders/shared/gpu_types.h), and the check of what the GPU renderers support. Shared by the
-// path tracer and ReSTIR so that both render the same scene.
+// (shaders/shared/gpu_types.h). Shared by the path tracer and ReSTIR so that both render the same
+// scene.
 #pragma once
 
 #include "gpu/resources.h"
@@ -8,14 +8,9 @@
 #include "scene/scene.h"
 #include "shaders/shared/gpu_types.h"
 
-#include <string>
 #include <vector>
 
 namespace plume {
-
-// Throws InputError naming the scene key for features a GPU renderer lacks (surfaces, where
-// !rendersSurfaces); `renderer` names the renderer in the message.
-void checkGpuSupports(const Scene& scene, const std::string& renderer, bool rendersSurfaces = false);
 
 // The scene's lights for the shaders (never empty: one zero light when the scene has none).
 // Throws InputError for more than GPU_MAX_LIGHTS lights.
@@ -26,8 +21,8 @@ shared::GpuCamera gpuCamera(const Camera& cam, int frame);
 bool sameCamera(const shared::GpuCamera& a, const shared::GpuCamera& b);  // every field but the padding
 
 // GpuFrame of `frame`: camera, medium, image size, bounces and light count from the scene;
-// the random-stream seed and frame key, and the samples per dispatch, from the caller.
-shared::GpuFrame gpuFrame(const Scene& scene, int frame, uint32_t seed, uint32_t frameKey, uint32_t sppPerDispatch);
+// the random-stream seed and frame key from the caller.
+shared::GpuFrame gpuFrame(const Scene& scene, int frame, uint32_t seed, uint32_t frameKey);
 
 // A progressive accumulation buffer (per pixel: vec4(mean rgb, n), vec4(M2 rgb, 0), Welford's
 // update on the GPU) read back as the mean and the variance of the mean.

@@ -21,7 +21,6 @@ PathTracer::PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const S
     : ctx_(ctx), scene_(scene), features_(featuresOf(scene)), compiler_(compiler),
       timer_(ctx, 2 * kBouncesPerSubmit) {
   features_.kernelCounters = kernelCounters;
-  checkGpuSupports(scene, "the GPU path tracer", true);
   envMap_ = std::make_unique<GpuEnvironmentMap>(ctx, scene);
   if (features_.surfaces) surfaces_ = std::make_unique<GpuSurfaces>(ctx, scene);
   const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
@@ -95,7 +94,7 @@ void PathTracer::setVolume(const GpuVolumeResources& volume) {
 }
 
 void PathTracer::beginFrame(int frame) {
-  frame_ = gpuFrame(scene_, frame, uint32_t(scene_.render.seed), uint32_t(frame), 1u);
+  frame_ = gpuFrame(scene_, frame, uint32_t(scene_.render.seed), uint32_t(frame));
   frame_.emitterCount = surfaces_ ? surfaces_->emitterCount() : 0u;
   accum_.fillZero();
   samples_ = 0;

@@ -31,7 +31,7 @@ const std::vector<SettingDesc>& renderSettingsTable() {
        &RenderSettings::restirMis, 0, 0, {"pairwise", "gbh"}},
       {"restir_light_candidates",
        "ReSTIR: light samples drawn at each candidate vertex and resampled by their unshadowed contribution "
-       "before one shadow ray (1 = one light sample; only used with emissive surfaces, several lights or a sky map)",
+       "before one shadow ray (1 = one light sample; used with emissive surfaces only)",
        &RenderSettings::restirLightCandidates, 1, 64, {}},
       {"restir_prefix",
        "ReSTIR: scattering vertices a reservoir's path holds (1-16, shared::RS_MAX_VERTICES); paths with more "
