@@ -46,7 +46,6 @@ class GpuSurfaces {
   double emitterPowerAt(glm::vec3 p) const;
   uint32_t emitterCount() const { return emitterCount_; }
   const geo::BvhStats& bvhStats() const { return stats_; }
-  int lightTreeDepth() const { return lightTreeDepth_; }
   double uploadMs() const { return uploadMs_; }
 
  private:

@@ -119,8 +119,7 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   // the unshadowed term prefers the sun, whose rays the smoke blocks, and L = 2 made the sky's
   // samples rare and heavy-tailed (ExtremeSuite.StronglyForwardScatteringBacklit failed: worst
   // pixel z -5.3); one sun, one point light or a constant sky alone have nothing to choose.
-  const bool manyLightSamples = features_.emitters;
-  const int lightCandidates = manyLightSamples ? options_.lightCandidates : 1;
+  const int lightCandidates = features_.emitters ? options_.lightCandidates : 1;
   using gpu::BindingType;
   // shaders/restir/bindings.glsl (numbers in shaders/shared/bindings.h)
   // Every binding in a table must be written before a dispatch (lavapipe reads them all): the
