@@ -374,41 +374,60 @@ VolTrack vol_track(uint tracker, uint v, vec3 xWorld, vec3 wWorld, float tMax, f
   VolKc kc = vol_kc_start();
 #endif
   float scale = vol_scale(v);  // sigma_t = scale * d, read once per walk
-  float a;
-  float b;
-  vec2 value;
-  while (vol_track_alive(tracker, s) && vol_walk_next(field, w, a, b, value)) {
-#ifdef PLUME_KERNEL_COUNTERS
-    vol_kc_segment(kc);
-#endif
-    float mu;
-#if defined(PLUME_VOL_MEAN_FIELD) || defined(PLUME_VOL_PREVIOUS)
-    if (field == VOL_FIELD_MEAN && w.exact) {
-      mu = vol_track_exact(tracker, s, w, scale, a, b);
-    } else
-#endif
-    {
-      mu = vol_track_segment(tracker, s, a, b, value);
-    }
-    if (!(mu > 0.0f)) continue;
-    float t = a;
+  float a = 0.0f;
+  float b = 0.0f;
+  vec2 value = vec2(0.0f);
+  float mu = 0.0f;
+  float t = 0.0f;
+  bool inSegment = false;  // drawing tentative collisions in [a, b) at rate mu
+  // The outer loop makes one tentative collision (one lookup) per iteration; the inner loop takes
+  // the draws and segments up to it and holds no lookup. A SIMD back end runs a loop's whole body
+  // on every iteration while any lane needs it (../shared/docs/LAVAPIPE.md), so the lookup now
+  // runs once per collision of the subgroup instead of once per draw (measured on lavapipe:
+  // extension 11 % faster, the same draws in the same order: bit-identical images).
+  for (;;) {
+    bool found = false;
+    uvec4 h = uvec4(0u);
     for (;;) {
-      if (++steps > VOL_MAX_STEPS) {
-        s.stop = true;
-        break;
+      if (inSegment) {
+        if (++steps > VOL_MAX_STEPS) {
+          s.stop = true;
+          break;
+        }
+#ifdef PLUME_KERNEL_COUNTERS
+        vol_kc_step(kc);
+#endif
+        h = rng_next4(rng);
+        t -= log(1.0f - rng_to_float(h.x)) / mu;
+        if (t < b) {
+          found = true;
+          break;
+        }
+        inSegment = false;
+      } else {
+        // As before a segment is entered: only where the tracker still needs one.
+        if (!vol_track_alive(tracker, s) || !vol_walk_next(field, w, a, b, value)) break;
+#ifdef PLUME_KERNEL_COUNTERS
+        vol_kc_segment(kc);
+#endif
+#if defined(PLUME_VOL_MEAN_FIELD) || defined(PLUME_VOL_PREVIOUS)
+        if (field == VOL_FIELD_MEAN && w.exact) {
+          mu = vol_track_exact(tracker, s, w, scale, a, b);
+        } else
+#endif
+        {
+          mu = vol_track_segment(tracker, s, a, b, value);
+        }
+        t = a;
+        inSegment = mu > 0.0f;
       }
-#ifdef PLUME_KERNEL_COUNTERS
-      vol_kc_step(kc);
-#endif
-      uvec4 h = rng_next4(rng);
-      t -= log(1.0f - rng_to_float(h.x)) / mu;
-      if (!(t < b)) break;
-#ifdef PLUME_KERNEL_COUNTERS
-      vol_kc_lookup(kc);
-#endif
-      vol_track_event(tracker, s, v, scale, o + t * d, t, mu, value, rng_to_float(h.y), rng);
-      if (s.stop) break;
     }
+    if (!found) break;
+#ifdef PLUME_KERNEL_COUNTERS
+    vol_kc_lookup(kc);
+#endif
+    vol_track_event(tracker, s, v, scale, o + t * d, t, mu, value, rng_to_float(h.y), rng);
+    if (s.stop) break;
   }
   if (steps > VOL_MAX_STEPS) atomicAdd(volCounters[0], 1u);  // truncated: counted, never silent
 #ifdef PLUME_KERNEL_COUNTERS
