@@ -202,15 +202,16 @@ class GpuBvh : public test::GpuTest {
   std::vector<RayResult> trace(const geo::FlatBvh& bvh, const std::vector<RayCase>& rays) {
     using gpu::BindingType;
     gpu::ComputePass pass(ctx(), compiler().compile("tests/bvh_kernels.comp", {}),
-                          {BindingType::StorageBuffer, BindingType::StorageBuffer, BindingType::StorageBuffer, BindingType::StorageBuffer},
+                          {BindingType::TexelBuffer, BindingType::TexelBuffer, BindingType::StorageBuffer, BindingType::StorageBuffer},
                           4, "bvh kernels", glm::uvec3(64, 1, 1));
     const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-    gpu::Buffer nodes(ctx(), bvh.nodes.size() * sizeof(sh::BvhNode), storage, "bvh nodes");
-    gpu::Buffer tris(ctx(), std::max<size_t>(bvh.triangles.size(), 1) * sizeof(sh::BvhTriangle), storage, "bvh triangles");
+    // As render/gpu_surfaces.cpp uploads them: each struct's bytes as 16-byte texels.
+    gpu::TexelBuffer nodes(ctx(), bvh.nodes.data(), bvh.nodes.size() * sizeof(sh::BvhNode) / 16,
+                           VK_FORMAT_R32G32B32A32_UINT, "bvh nodes");
+    gpu::TexelBuffer tris(ctx(), bvh.triangles.empty() ? nullptr : bvh.triangles.data(),
+                          bvh.triangles.size() * sizeof(sh::BvhTriangle) / 16, VK_FORMAT_R32G32B32A32_UINT, "bvh triangles");
     gpu::Buffer in(ctx(), rays.size() * sizeof(RayCase), storage, "rays");
     gpu::Buffer out(ctx(), rays.size() * sizeof(RayResult), storage, "results");
-    nodes.upload(bvh.nodes.data(), bvh.nodes.size() * sizeof(sh::BvhNode));
-    if (!bvh.triangles.empty()) tris.upload(bvh.triangles.data(), bvh.triangles.size() * sizeof(sh::BvhTriangle));
     in.upload(rays.data(), rays.size() * sizeof(RayCase));
     pass.set.bind(0, nodes);
     pass.set.bind(1, tris);

@@ -50,11 +50,8 @@ TEST_F(GpuShared, GlslAndCppAgree) {
     cases[i].dir = glm::vec4(wi, 2.0f * sh::rng_float(setup) - 1.0f);
     cases[i].seed = glm::uvec4(sh::rng_uint(setup) % 4096, sh::rng_uint(setup) % 4096, i, sh::rng_uint(setup));
   }
-  using gpu::BindingType;
   gpu::ComputePass pass(ctx(), compiler().compile("tests/shared_kernels.comp", {}),
-                        {BindingType::StorageBuffer, BindingType::SampledImage, BindingType::StorageBuffer,
-                         BindingType::StorageBuffer, BindingType::StorageBuffer, BindingType::StorageBuffer,
-                         BindingType::StorageBuffer},
+                        gpu::bindingTable(7, GpuVolumeResources::bindingTypes(false, false)),
                         4, "shared kernels", glm::uvec3(64, 1, 1));
   volume.bind(pass.set);
   gpu::Buffer in(ctx(), n * sizeof(KernelCase), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "cases");

@@ -29,10 +29,8 @@ class LoopGuard : public test::GpuTest {
     loaded.grid = test::makeNoiseGrid(8, 0.1);
     const BakedVolume bake = bakeVolume(loaded);
     GpuVolumeResources volume(ctx(), bake, 1.0f);
-    using gpu::BindingType;
     gpu::ComputePass pass(ctx(), compiler().compile("tests/loop_guard_kernel.comp", {}),
-                          {BindingType::StorageBuffer, BindingType::SampledImage, BindingType::StorageBuffer,
-                           BindingType::StorageBuffer, BindingType::StorageBuffer, BindingType::StorageBuffer},
+                          gpu::bindingTable(shared::BIND_VOLUME_COUNTERS + 2, GpuVolumeResources::bindingTypes(false, false)),
                           8, "loop guard", glm::uvec3(64, 1, 1));
     volume.bind(pass.set);
     const uint32_t n = 64;

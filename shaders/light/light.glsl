@@ -102,7 +102,8 @@ vec3 light_escaped(vec3 dir) {
   vec3 sum = vec3(0.0f);
 #ifdef PLUME_HAS_ENV
   for (uint i = 0u; i < frame.lightCount; ++i) {
-    if (lights[i].type == LIGHT_ENVIRONMENT) sum += lights[i].emission;
+    GpuLight l = light_at(i);
+    if (l.type == LIGHT_ENVIRONMENT) sum += l.emission;
   }
 #endif
 #ifdef PLUME_HAS_ENV_MAP

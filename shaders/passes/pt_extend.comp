@@ -13,6 +13,8 @@ layout(local_size_x = 64) in;
 #include "../volume/loop_guard.glsl"
 
 void main() {
+  vol_load_params();
+  scene_load_params();
   uint i = gl_GlobalInvocationID.x;
   bool camera = ptPush.firstExtend != 0u;
   bool live = i < (camera ? ptPush.slots : wave.extendArgs.w);

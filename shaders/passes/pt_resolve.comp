@@ -14,6 +14,7 @@ layout(local_size_x = 64) in;
 layout(std430, binding = BIND_PT_ACCUM) buffer AccumBuffer { vec4 ptAccum[]; };
 
 void main() {
+  scene_load_params();
   uint i = gl_GlobalInvocationID.x;
   if (i >= ptPush.pixelCount) return;
   uint index = ptPush.pixelBegin + i;

@@ -12,6 +12,8 @@ layout(local_size_x = 64) in;
 #include "../volume/loop_guard.glsl"
 
 void main() {
+  vol_load_params();
+  scene_load_params();
   uint i = gl_GlobalInvocationID.x;
   bool live = i < wave.shadeArgs.w;
   uint slot = live ? ptQueues[ptPush.slots + i] : 0u;

@@ -19,6 +19,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 // Compiled twice: PLUME_RS_TEMPORAL 1 (temporal reuse) or 0 (a spatial round), so that each
 // pipeline holds only its own code (see restir/reuse.glsl on PLUME_RS_MIS).
 void main() {
+  rs_load_params();
   uvec2 pixel = gl_GlobalInvocationID.xy;
   if (pixel.x >= frame.size.x || pixel.y >= frame.size.y) return;
   rs_reuse_pixel(pixel, pixel.y * frame.size.x + pixel.x, PLUME_RS_TEMPORAL != 0, push.spatialRound, push.inSet,

@@ -11,6 +11,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 #include "../volume/loop_guard.glsl"
 
 void main() {
+  rs_load_params();
   uvec2 pixel = gl_GlobalInvocationID.xy;
   if (pixel.x >= frame.size.x || pixel.y >= frame.size.y) return;
   rs_shade_pixel(pixel, push.inSet, push.restartAccumulation != 0u);

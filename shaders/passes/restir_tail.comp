@@ -14,6 +14,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 #include "../volume/loop_guard.glsl"
 
 void main() {
+  rs_load_params();
   uvec2 pixel = gl_GlobalInvocationID.xy;
   if (pixel.x >= frame.size.x || pixel.y >= frame.size.y) return;
   bool alive = rs_tail_pixel(pixel, push.restartAccumulation != 0u);

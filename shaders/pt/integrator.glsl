@@ -44,7 +44,7 @@ float pt_power_heuristic(float a, float b) { return a * a / (a * a + b * b); }
 vec3 pt_direct(PathVertex v, inout RngState rng) {
   vec3 sum = vec3(0.0f);
   for (uint i = 0u; i < frame.lightCount; ++i) {
-    GpuLight l = lights[i];
+    GpuLight l = light_at(i);
     vec2 u = vec2(0.0f);
     if (light_samples_direction(l)) u = rng_float2(rng);
     vec3 w;

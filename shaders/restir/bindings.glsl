@@ -19,7 +19,8 @@
 #include "../surface/surfaces.glsl"
 #endif
 
-layout(std430, binding = BIND_RS_PARAMS) readonly buffer RestirParamBuffer { RestirParams rsp; };
+layout(std430, binding = BIND_RS_PARAMS) readonly buffer RestirParamBuffer { RestirParams rsParams; };
+RestirParams rsp;  // a private copy (volume/bindings.glsl says why), loaded by rs_load_params()
 // Reservoir sets: [set * pixels + pixel].
 layout(std430, binding = BIND_RS_RESERVOIRS) buffer ReservoirBuffer { RsPacked rsReservoirs[]; };
 // Path heads as stored: two uvec4 per RsPathHead (its C++ layout), loaded and stored whole by
@@ -34,5 +35,12 @@ layout(std430, binding = BIND_RS_OUTPUT) buffer OutputBuffer { vec4 rsOutput[]; 
 layout(std430, binding = BIND_RS_COUNTERS) buffer RestirCounterBuffer { uint rsCounters[]; };
 
 layout(push_constant) uniform PushBlock { RsPush push; };
+
+// The private copies of every parameter block: first thing in every ReSTIR kernel.
+void rs_load_params() {
+  vol_load_params();
+  scene_load_params();
+  rsp = rsParams;
+}
 
 #endif

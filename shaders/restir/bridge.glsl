@@ -75,9 +75,9 @@ float rs_sample_light(PathVertex vx, vec3 u, inout RngState rng, out uint light,
   if (light == frame.lightCount) {
     return pdf * surf_sample_emitter_at(vx.x, vec3(rng_to_float(e.x), rng_to_float(e.y), rng_to_float(e.z)), prim, ls);
   }
-  GpuLight l = lights[min(light, max(frame.lightCount, 1u) - 1u)];  // (in range on every lane)
+  GpuLight l = light_at(min(light, max(frame.lightCount, 1u) - 1u));  // (in range on every lane)
 #else
-  GpuLight l = lights[light];
+  GpuLight l = light_at(light);
 #endif
   if (!light_samples_direction(l)) return pdf;
 #ifdef PLUME_HAS_SURFACES
@@ -169,9 +169,9 @@ bool rs_light_connect(PathVertex vx, uint light, vec2 ls, uint prim, bool withMi
     c.value = surf_emission(prim) * scatter * (mis * cosLight / (dist * dist));
     return true;
   }
-  GpuLight l = lights[min(light, max(frame.lightCount, 1u) - 1u)];
+  GpuLight l = light_at(min(light, max(frame.lightCount, 1u) - 1u));
 #else
-  GpuLight l = lights[light];
+  GpuLight l = light_at(light);
 #endif
   vec3 Le;
   c.value = vec3(0.0f);

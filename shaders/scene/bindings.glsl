@@ -8,8 +8,23 @@
 #include "../shared/bindings.h"
 #include "../shared/gpu_types.h"
 
-layout(std430, binding = BIND_FRAME) readonly buffer FrameBuffer { GpuFrame frame; };
-layout(std430, binding = BIND_LIGHTS) readonly buffer LightBuffer { GpuLight lights[]; };
+// The frame's parameters are read once per invocation into a private copy (`frame`, loaded by
+// scene_load_params() at a kernel's entry), as the volume's (volume/bindings.glsl).
+layout(std430, binding = BIND_FRAME) readonly buffer FrameBuffer { GpuFrame frameParams; };
+GpuFrame frame;
+void scene_load_params() { frame = frameParams; }
+// The lights as a texel buffer of uvec4, two per GpuLight (the same reason; surface/texels.glsl).
+layout(binding = BIND_LIGHTS) uniform usamplerBuffer lightTexels;
+GpuLight light_at(uint i) {
+  uvec4 a = texelFetch(lightTexels, int(2u * i));
+  uvec4 b = texelFetch(lightTexels, int(2u * i + 1u));
+  GpuLight l;
+  l.dirOrPos = uintBitsToFloat(a.xyz);
+  l.type = a.w;
+  l.emission = uintBitsToFloat(b.xyz);
+  l.versine = uintBitsToFloat(b.w);
+  return l;
+}
 #ifdef PLUME_LIGHT_CHOICE
 layout(std430, binding = BIND_LIGHT_CHOICE) readonly buffer LightChoiceBuffer { GpuLightChoice lightChoice[]; };
 #endif

@@ -18,18 +18,54 @@
 #ifndef PLUME_SURF_BINDING_SHIFT
 #define PLUME_SURF_BINDING_SHIFT 0u
 #endif
-layout(std430, binding = BIND_BVH_NODES + PLUME_SURF_BINDING_SHIFT) readonly buffer BvhNodeBuffer { BvhNode bvhNodes[]; };
-layout(std430, binding = BIND_BVH_TRIANGLES + PLUME_SURF_BINDING_SHIFT) readonly buffer BvhTriangleBuffer { BvhTriangle bvhTriangles[]; };
-#define BVH_NODE(i) bvhNodes[i]
-#define BVH_TRIANGLE(i) bvhTriangles[i]
+// Every array is a texel buffer of uvec4 (surface/texels.glsl says why).
+#include "texels.glsl"
+layout(binding = BIND_BVH_NODES + PLUME_SURF_BINDING_SHIFT) uniform usamplerBuffer bvhNodeTexels;
+layout(binding = BIND_BVH_TRIANGLES + PLUME_SURF_BINDING_SHIFT) uniform usamplerBuffer bvhTriangleTexels;
+#define BVH_NODE(i) BVH_NODE_TEXELS(bvhNodeTexels, i)
+#define BVH_TRIANGLE(i) BVH_TRIANGLE_TEXELS(bvhTriangleTexels, i)
 #include "bvh.glsl"
 
-layout(std430, binding = BIND_SURF_TRIANGLES + PLUME_SURF_BINDING_SHIFT) readonly buffer SurfTriangleBuffer { GpuSurfaceTriangle surfTriangles[]; };
-layout(std430, binding = BIND_SURF_MATERIALS + PLUME_SURF_BINDING_SHIFT) readonly buffer SurfMaterialBuffer { GpuSurfaceMaterial surfMaterials[]; };
+layout(binding = BIND_SURF_TRIANGLES + PLUME_SURF_BINDING_SHIFT) uniform usamplerBuffer surfTriangleTexels;
+layout(binding = BIND_SURF_MATERIALS + PLUME_SURF_BINDING_SHIFT) uniform usamplerBuffer surfMaterialTexels;
+
+// Triangle prim's fields (GpuSurfaceTriangle: 6 texels), each read where it is needed.
+uvec4 surf_triangle_texel(uint prim, uint k) { return SURF_TEXEL(surfTriangleTexels, 6u * prim + k); }
+vec3 surf_vertex(uint prim, uint k) { return uintBitsToFloat(surf_triangle_texel(prim, k).xyz); }  // v0, v1, v2
+uint surf_surface(uint prim) { return surf_triangle_texel(prim, 0u).w; }
+// Material s (GpuSurfaceMaterial: 3 texels): its BSDF, and the radiance leaving its front side.
+Bsdf surf_material_bsdf(uint s) {
+  uvec4 a = SURF_TEXEL(surfMaterialTexels, 3u * s);
+  uvec4 b = SURF_TEXEL(surfMaterialTexels, 3u * s + 1u);
+  Bsdf f;
+  f.color = uintBitsToFloat(a.xyz);
+  f.type = a.w;
+  f.alpha = uintBitsToFloat(b.x);
+  f.pad0 = uintBitsToFloat(b.y);
+  f.pad1 = uintBitsToFloat(b.z);
+  f.pad2 = uintBitsToFloat(b.w);
+  return f;
+}
+vec3 surf_material_emission(uint s) { return uintBitsToFloat(SURF_TEXEL(surfMaterialTexels, 3u * s + 2u).xyz); }
+
 #ifdef PLUME_HAS_EMITTERS
-layout(std430, binding = BIND_EMITTERS + PLUME_SURF_BINDING_SHIFT) readonly buffer LightTreeBuffer { GpuLightNode surfLightNodes[]; };
-#define LT_NODE(i) surfLightNodes[i]
-#include "../shared/light_tree.h"  // again, for the descent over surfLightNodes
+layout(binding = BIND_EMITTERS + PLUME_SURF_BINDING_SHIFT) uniform usamplerBuffer surfLightNodeTexels;
+// A light tree node (GpuLightNode: 3 texels).
+GpuLightNode surf_light_node(uint i) {
+  uvec4 a = SURF_TEXEL(surfLightNodeTexels, 3u * i);
+  uvec4 b = SURF_TEXEL(surfLightNodeTexels, 3u * i + 1u);
+  uvec4 c = SURF_TEXEL(surfLightNodeTexels, 3u * i + 2u);
+  GpuLightNode n;
+  n.boxMin = uintBitsToFloat(a.xyz);
+  n.power = uintBitsToFloat(a.w);
+  n.boxMax = uintBitsToFloat(b.xyz);
+  n.cosCone = uintBitsToFloat(b.w);
+  n.axis = uintBitsToFloat(c.xyz);
+  n.child = c.w;
+  return n;
+}
+#define LT_NODE(i) surf_light_node(i)
+#include "../shared/light_tree.h"  // again, for the descent over the tree's texels
 #endif
 
 const float SURF_FAR = 3.0e38f;
@@ -38,26 +74,26 @@ const float SURF_RELATIVE_OFFSET = 1e-4f;
 
 // The unit geometric normal of the triangle's front side (counter-clockwise seen from it).
 vec3 surf_normal(uint prim) {
-  GpuSurfaceTriangle t = surfTriangles[prim];
-  return normalize(cross(t.v1 - t.v0, t.v2 - t.v0));
+  vec3 v0 = surf_vertex(prim, 0u);
+  return normalize(cross(surf_vertex(prim, 1u) - v0, surf_vertex(prim, 2u) - v0));
 }
 
 // The shading normal at barycentrics uv (Embree's: p = (1 - u - v) v0 + u v1 + v v2): the mesh's
 // interpolated normals where it has them, else the geometric normal.
 vec3 surf_shading_normal(uint prim, vec2 uv, vec3 geometric) {
-  GpuSurfaceTriangle t = surfTriangles[prim];
-  if (t.hasNormals == 0u) return geometric;
-  vec3 n = (1.0f - uv.x - uv.y) * t.n0 + uv.x * t.n1 + uv.y * t.n2;
+  if (surf_triangle_texel(prim, 2u).w == 0u) return geometric;  // hasNormals
+  vec3 n = (1.0f - uv.x - uv.y) * uintBitsToFloat(surf_triangle_texel(prim, 3u).xyz) +
+           uv.x * uintBitsToFloat(surf_triangle_texel(prim, 4u).xyz) + uv.y * uintBitsToFloat(surf_triangle_texel(prim, 5u).xyz);
   float len = length(n);
   return len > 0.0f ? n / len : geometric;
 }
 
-Bsdf surf_bsdf(uint prim) { return surfMaterials[surfTriangles[prim].surface].bsdf; }
+Bsdf surf_bsdf(uint prim) { return surf_material_bsdf(surf_surface(prim)); }
 
 // The radiance a ray of direction dir sees where it hits triangle prim (front normal n): the
 // surface's emission on the front side, nothing on the back.
 vec3 surf_emitted(uint prim, vec3 n, vec3 dir) {
-  return dot(n, dir) < 0.0f ? surfMaterials[surfTriangles[prim].surface].emission : vec3(0.0f);
+  return dot(n, dir) < 0.0f ? surf_material_emission(surf_surface(prim)) : vec3(0.0f);
 }
 
 float surf_offset_length(vec3 p) { return SURF_RELATIVE_OFFSET * (1.0f + plume_max3(abs(p))); }
@@ -80,11 +116,14 @@ vec2 surf_uniform_barycentrics(vec2 u) {
 }
 
 vec3 surf_triangle_point(uint prim, vec2 b) {
-  GpuSurfaceTriangle t = surfTriangles[prim];
-  return (1.0f - b.x - b.y) * t.v0 + b.x * t.v1 + b.y * t.v2;
+  return (1.0f - b.x - b.y) * surf_vertex(prim, 0u) + b.x * surf_vertex(prim, 1u) + b.y * surf_vertex(prim, 2u);
 }
 
-vec3 surf_emission(uint prim) { return surfMaterials[surfTriangles[prim].surface].emission; }
+vec3 surf_emission(uint prim) { return surf_material_emission(surf_surface(prim)); }
+
+// An emissive triangle's 1 / area (0: dark) and its trail in the light tree.
+float surf_emitter_inv_area(uint prim) { return uintBitsToFloat(surf_triangle_texel(prim, 1u).w); }
+uint surf_light_trail(uint prim) { return surf_triangle_texel(prim, 3u).w; }
 
 // A point on the emissive triangles for the shading point x (u in [0,1)³): a triangle from the
 // light tree (u.x), a uniform point in it (u.yz) as barycentrics. Returns its area density
@@ -93,14 +132,14 @@ float surf_sample_emitter_at(vec3 x, vec3 u, out uint prim, out vec2 barycentric
   float pmf;
   prim = lt_sample(x, u.x, pmf);
   barycentrics = surf_uniform_barycentrics(u.yz);
-  return pmf > 0.0f ? pmf * surfTriangles[prim].emitterInvArea : 0.0f;
+  return pmf > 0.0f ? pmf * surf_emitter_inv_area(prim) : 0.0f;
 }
 
 // The area density with which surf_sample_emitter_at(x) picks a point of triangle prim (0: it is
 // dark, or cannot light x).
 float surf_emitter_pdf_at(uint prim, vec3 x) {
-  GpuSurfaceTriangle t = surfTriangles[prim];
-  return t.emitterInvArea > 0.0f ? lt_pmf(x, t.lightTrail) * t.emitterInvArea : 0.0f;
+  float invArea = surf_emitter_inv_area(prim);
+  return invArea > 0.0f ? lt_pmf(x, surf_light_trail(prim)) * invArea : 0.0f;
 }
 #endif
 

@@ -7,10 +7,12 @@ layout(local_size_x = 64) in;
 
 #include "../shared/bvh.h"
 
-layout(std430, binding = 0) readonly buffer Nodes { BvhNode bvhNodes[]; };
-layout(std430, binding = 1) readonly buffer Triangles { BvhTriangle bvhTriangles[]; };
-#define BVH_NODE(i) bvhNodes[i]
-#define BVH_TRIANGLE(i) bvhTriangles[i]
+// The nodes and triangles as texel buffers of uvec4, read as surface/surfaces.glsl reads them.
+#include "../surface/texels.glsl"
+layout(binding = 0) uniform usamplerBuffer bvhNodeTexels;
+layout(binding = 1) uniform usamplerBuffer bvhTriangleTexels;
+#define BVH_NODE(i) BVH_NODE_TEXELS(bvhNodeTexels, i)
+#define BVH_TRIANGLE(i) BVH_TRIANGLE_TEXELS(bvhTriangleTexels, i)
 #include "../surface/bvh.glsl"
 
 struct RayCase {

@@ -14,6 +14,7 @@ layout(std430, binding = BIND_TEST_RESULTS) writeonly buffer Results { uint coun
 layout(push_constant) uniform Push { uint iterations; uint probe; } pc;
 
 void main() {
+  vol_load_params();
   uint n = 0u;
   for (uint i = 0u; i < pc.iterations; ++i) n += 1u;
   counted[gl_GlobalInvocationID.x] = n;

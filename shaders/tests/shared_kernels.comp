@@ -33,6 +33,7 @@ layout(std430, binding = BIND_TEST_RESULTS) writeonly buffer Results { KernelRes
 layout(push_constant) uniform Push { uint count; } pc;
 
 void main() {
+  vol_load_params();
   uint i = gl_GlobalInvocationID.x;
   if (i >= pc.count) return;
   KernelCase c = cases[i];

@@ -9,33 +9,48 @@
 #include "../shared/bindings.h"
 #include "../shared/gpu_types.h"
 
-layout(std430, binding = BIND_VOLUME) readonly buffer VolumeBuffer { GpuVolume vol; };
+// Every array that lanes read at places of their own is a texel buffer, and the parameter block
+// is read once per invocation into a private copy (`vol`, loaded by vol_load_params() at a
+// kernel's entry): on a SIMD back end such as lavapipe each storage-buffer read is a scalar loop
+// over the lanes with a bounds check per lane, a texel fetch one gather, a private variable a
+// register (docs/architecture.md, "Descriptor kinds").
+layout(std430, binding = BIND_VOLUME) readonly buffer VolumeBuffer { GpuVolume volParams; };
+GpuVolume vol;
 layout(binding = BIND_ATLAS) uniform sampler3D volAtlas;
-layout(std430, binding = BIND_INDIRECTION) readonly buffer IndirectionBuffer { uint volIndirection[]; };
-layout(std430, binding = BIND_MAJORANTS) readonly buffer MajorantBuffer { float volMajorants[]; };
+layout(binding = BIND_INDIRECTION) uniform usamplerBuffer volIndirection;  // packed slot per brick
+layout(binding = BIND_MAJORANTS) uniform samplerBuffer volMajorants;       // the majorant hierarchy
 // volCounters[0]: tracking loops truncated by VOL_MAX_STEPS (no silent caps)
 // volCounters[1]: shader invocations whose loops the driver cut (volume/loop_guard.glsl)
 layout(std430, binding = BIND_VOLUME_COUNTERS) buffer CounterBuffer { uint volCounters[]; };
 
 #if defined(PLUME_VOL_MEAN_FIELD) || defined(PLUME_VOL_PREVIOUS)
 // Per atlas slot 512 words: each voxel's mean and residual bound as two float16.
-layout(std430, binding = BIND_MEAN_FIELD) readonly buffer MeanFieldBuffer { uint volMeanField[]; };
+layout(binding = BIND_MEAN_FIELD) uniform usamplerBuffer volMeanField;
 #endif
 
 #ifdef PLUME_HAS_EMISSION
 // The emission grid in the density's slots (bake.h emissionF32), and the blackbody table.
 layout(binding = BIND_EMISSION_ATLAS) uniform sampler3D volEmissionAtlas;
-layout(std430, binding = BIND_BLACKBODY) readonly buffer BlackbodyBuffer { vec4 volBlackbody[]; };
+layout(binding = BIND_BLACKBODY) uniform samplerBuffer volBlackbody;
 #endif
 
 #ifdef PLUME_VOL_PREVIOUS
-layout(std430, binding = BIND_PREV_VOLUME) readonly buffer PrevVolumeBuffer { GpuVolume prevVol; };
+layout(std430, binding = BIND_PREV_VOLUME) readonly buffer PrevVolumeBuffer { GpuVolume prevVolParams; };
+GpuVolume prevVol;
 layout(binding = BIND_PREV_ATLAS) uniform sampler3D prevAtlas;
-layout(std430, binding = BIND_PREV_INDIRECTION) readonly buffer PrevIndirectionBuffer { uint prevIndirection[]; };
-layout(std430, binding = BIND_PREV_MEAN_FIELD) readonly buffer PrevMeanFieldBuffer { uint prevMeanField[]; };
+layout(binding = BIND_PREV_INDIRECTION) uniform usamplerBuffer prevIndirection;
+layout(binding = BIND_PREV_MEAN_FIELD) uniform usamplerBuffer prevMeanField;
 #ifdef PLUME_HAS_EMISSION
 layout(binding = BIND_PREV_EMISSION_ATLAS) uniform sampler3D prevEmissionAtlas;
 #endif
 #endif
+
+// The private copies of the parameter blocks: first thing in every kernel that reads the volume.
+void vol_load_params() {
+  vol = volParams;
+#ifdef PLUME_VOL_PREVIOUS
+  prevVol = prevVolParams;
+#endif
+}
 
 #endif

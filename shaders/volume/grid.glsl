@@ -23,12 +23,14 @@ const uint VOL_PREVIOUS = 1u;
 
 // Selections between the two volumes' resources are plain ternaries (a select), with no control flow.
 #ifdef PLUME_VOL_PREVIOUS
-uint vol_indirection(uint v, uint i) { return v == VOL_CURRENT ? volIndirection[i] : prevIndirection[i]; }
+uint vol_indirection(uint v, uint i) {
+  return v == VOL_CURRENT ? texelFetch(volIndirection, int(i)).r : texelFetch(prevIndirection, int(i)).r;
+}
 float vol_texel(uint v, ivec3 t) {
   return v == VOL_CURRENT ? texelFetch(volAtlas, t, 0).r : texelFetch(prevAtlas, t, 0).r;
 }
 #else
-uint vol_indirection(uint v, uint i) { return volIndirection[i]; }
+uint vol_indirection(uint v, uint i) { return texelFetch(volIndirection, int(i)).r; }
 float vol_texel(uint v, ivec3 t) { return texelFetch(volAtlas, t, 0).r; }
 #endif
 
@@ -74,7 +76,7 @@ float vol_density(uint v, vec3 p) {
 }
 
 #ifdef PLUME_HAS_EMISSION
-#define BB_TABLE(i) volBlackbody[i].rgb
+#define BB_TABLE(i) texelFetch(volBlackbody, int(i)).rgb
 #include "../shared/blackbody.h"
 
 #ifdef PLUME_VOL_PREVIOUS
@@ -139,7 +141,7 @@ vec3 vol_emitted_radiance_world(uint v, vec3 xWorld) {
 // per brick; cells relative to brickOrigin). Only the current volume is tracked against majorants.
 float vol_level_max(int level, ivec3 cell) {
   ivec3 dims = vol.levels[level].cells;
-  return volMajorants[vol.levelOffset[level] + uint((cell.z * dims.y + cell.y) * dims.x + cell.x)];
+  return texelFetch(volMajorants, int(vol.levelOffset[level]) + (cell.z * dims.y + cell.y) * dims.x + cell.x).r;
 }
 float vol_brick_majorant(ivec3 cell) { return vol.densityScale * vol_level_max(0, cell); }
 
@@ -155,9 +157,9 @@ uint vol_mean_field_base(uint v, uint slot) {
 // of the trilinear density over the voxel and a bound on the density's deviation from it.
 vec2 vol_mean_field(uint v, uint i) {
 #ifdef PLUME_VOL_PREVIOUS
-  return unpackHalf2x16(v == VOL_CURRENT ? volMeanField[i] : prevMeanField[i]);
+  return unpackHalf2x16(v == VOL_CURRENT ? texelFetch(volMeanField, int(i)).r : texelFetch(prevMeanField, int(i)).r);
 #else
-  return unpackHalf2x16(volMeanField[i]);
+  return unpackHalf2x16(texelFetch(volMeanField, int(i)).r);
 #endif
 }
 #endif

@@ -12,6 +12,7 @@ VkDescriptorType descriptorType(BindingType t) {
     case BindingType::StorageBuffer: return VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     case BindingType::UniformBuffer: return VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
     case BindingType::SampledImage: return VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+    case BindingType::TexelBuffer: return VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
   }
   return VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
 }
@@ -92,7 +93,8 @@ DescriptorSet::~DescriptorSet() {
 
 void DescriptorSet::bind(uint32_t binding, const Buffer& buffer) {
   PLUME_CHECK(binding < pipeline_.bindings().size());
-  PLUME_CHECK(pipeline_.bindings()[binding] != BindingType::SampledImage);
+  PLUME_CHECK(pipeline_.bindings()[binding] == BindingType::StorageBuffer ||
+              pipeline_.bindings()[binding] == BindingType::UniformBuffer);
   VkDescriptorBufferInfo bi{buffer.handle(), 0, VK_WHOLE_SIZE};
   VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
   w.dstSet = set_;
@@ -113,6 +115,19 @@ void DescriptorSet::bind(uint32_t binding, const Image3D& image) {
   w.descriptorCount = 1;
   w.descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
   w.pImageInfo = &ii;
+  vkUpdateDescriptorSets(ctx_.device(), 1, &w, 0, nullptr);
+}
+
+void DescriptorSet::bind(uint32_t binding, const TexelBuffer& buffer) {
+  PLUME_CHECK(binding < pipeline_.bindings().size());
+  PLUME_CHECK(pipeline_.bindings()[binding] == BindingType::TexelBuffer);
+  VkBufferView view = buffer.view();
+  VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+  w.dstSet = set_;
+  w.dstBinding = binding;
+  w.descriptorCount = 1;
+  w.descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
+  w.pTexelBufferView = &view;
   vkUpdateDescriptorSets(ctx_.device(), 1, &w, 0, nullptr);
 }
 
@@ -159,7 +174,7 @@ std::vector<std::pair<std::string, double>> GpuTimer::read() {
   return out;
 }
 
-std::vector<BindingType> bindingTable(uint32_t count, std::initializer_list<std::pair<uint32_t, BindingType>> others) {
+std::vector<BindingType> bindingTable(uint32_t count, const BindingTypes& others) {
   std::vector<BindingType> table(count, BindingType::StorageBuffer);
   for (const auto& [binding, type] : others) {
     PLUME_CHECK(binding < count);

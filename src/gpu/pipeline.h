@@ -16,11 +16,14 @@
 
 namespace plume::gpu {
 
-enum class BindingType { StorageBuffer, UniformBuffer, SampledImage };
+// StorageBuffer: read-write arrays. UniformBuffer: a small parameter block that every lane reads
+// at the same place (std140). TexelBuffer: a read-only array read per lane (gpu::TexelBuffer).
+enum class BindingType { StorageBuffer, UniformBuffer, SampledImage, TexelBuffer };
 
 // A pass's binding table: bindings 0 .. count-1 are storage buffers except those listed with
 // another type (binding numbers are named in shaders/shared/bindings.h).
-std::vector<BindingType> bindingTable(uint32_t count, std::initializer_list<std::pair<uint32_t, BindingType>> others);
+using BindingTypes = std::vector<std::pair<uint32_t, BindingType>>;
+std::vector<BindingType> bindingTable(uint32_t count, const BindingTypes& others);
 
 class ComputePipeline {
  public:
@@ -57,6 +60,7 @@ class DescriptorSet {
 
   void bind(uint32_t binding, const Buffer& buffer);
   void bind(uint32_t binding, const Image3D& image);
+  void bind(uint32_t binding, const TexelBuffer& buffer);
   VkDescriptorSet handle() const { return set_; }
 
  private:

@@ -111,6 +111,46 @@ void Buffer::fillZero() {
 }
 
 // ---------------------------------------------------------------------------------------------
+TexelBuffer::TexelBuffer(Context& ctx, const void* data, size_t count, VkFormat format, const std::string& name)
+    : ctx_(&ctx) {
+  PLUME_CHECK(format == VK_FORMAT_R32_SFLOAT || format == VK_FORMAT_R32_UINT || format == VK_FORMAT_R32G32B32A32_SFLOAT ||
+              format == VK_FORMAT_R32G32B32A32_UINT);
+  const size_t texelBytes = format == VK_FORMAT_R32_SFLOAT || format == VK_FORMAT_R32_UINT ? 4 : 16;
+  if (count == 0) count = 1;  // Vulkan forbids empty buffers; an empty array binds one texel
+  if (count > ctx.limits().maxTexelBufferElements) {
+    throw InputError(strf("%s: %s needs %zu elements, more than the device's texel buffer limit of %u (%s)",
+                          ctx.deviceName().c_str(), name.c_str(), count, ctx.limits().maxTexelBufferElements,
+                          kTooLargeHint));
+  }
+  buffer_ = Buffer(ctx, count * texelBytes, VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT, name);
+  if (data) buffer_.upload(data, count * texelBytes);
+  VkBufferViewCreateInfo vi{VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO};
+  vi.buffer = buffer_.handle();
+  vi.format = format;
+  vi.offset = 0;
+  vi.range = VK_WHOLE_SIZE;
+  PLUME_VK(vkCreateBufferView(ctx.device(), &vi, nullptr, &view_));
+}
+
+TexelBuffer::~TexelBuffer() { release(); }
+
+TexelBuffer& TexelBuffer::operator=(TexelBuffer&& o) noexcept {
+  if (this != &o) {
+    release();
+    ctx_ = std::exchange(o.ctx_, nullptr);
+    buffer_ = std::move(o.buffer_);
+    view_ = std::exchange(o.view_, VK_NULL_HANDLE);
+  }
+  return *this;
+}
+
+void TexelBuffer::release() {
+  if (ctx_ && view_) vkDestroyBufferView(ctx_->device(), view_, nullptr);
+  view_ = VK_NULL_HANDLE;
+  buffer_ = Buffer();
+}
+
+// ---------------------------------------------------------------------------------------------
 Image3D::Image3D(Context& ctx, glm::ivec3 extent, VkFormat format, size_t texelBytes, const std::string& name)
     : ctx_(&ctx), extent_(extent), texelBytes_(texelBytes) {
   const uint32_t maxSide = ctx.limits().maxImageDimension3D;

@@ -46,6 +46,31 @@ class Buffer {
   void* mapped_ = nullptr;  // persistently mapped when host-visible
 };
 
+// A read-only array that shaders read with texelFetch (a uniform texel buffer: `samplerBuffer`,
+// `usamplerBuffer`), one 32-bit texel per element. Per-lane reads of a storage buffer are a scalar
+// loop over the lanes on a SIMD back end such as lavapipe; a texel fetch is one gather
+// (docs/architecture.md, "Descriptor kinds").
+class TexelBuffer {
+ public:
+  TexelBuffer() = default;
+  // `format`: VK_FORMAT_R32_SFLOAT, VK_FORMAT_R32_UINT (4 bytes per element),
+  // VK_FORMAT_R32G32B32A32_SFLOAT or _UINT (16); `count` elements, uploaded from `data` where
+  // not null.
+  TexelBuffer(Context& ctx, const void* data, size_t count, VkFormat format, const std::string& name);
+  ~TexelBuffer();
+  TexelBuffer(TexelBuffer&& o) noexcept { *this = std::move(o); }
+  TexelBuffer& operator=(TexelBuffer&& o) noexcept;
+
+  VkBufferView view() const { return view_; }
+  const Buffer& buffer() const { return buffer_; }
+
+ private:
+  void release();
+  Context* ctx_ = nullptr;
+  Buffer buffer_;
+  VkBufferView view_ = VK_NULL_HANDLE;
+};
+
 // A sampled 3D image (read with texelFetch) with a nearest sampler.
 class Image3D {
  public:

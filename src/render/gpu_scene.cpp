@@ -47,6 +47,12 @@ std::vector<shared::GpuLight> gpuLights(const Scene& scene) {
   return out;
 }
 
+gpu::TexelBuffer lightTexels(gpu::Context& ctx, const std::vector<shared::GpuLight>& lights) {
+  static_assert(sizeof(shared::GpuLight) == 32, "two uvec4 texels per light");
+  PLUME_CHECK(!lights.empty());
+  return gpu::TexelBuffer(ctx, lights.data(), lights.size() * 2, VK_FORMAT_R32G32B32A32_UINT, "lights");
+}
+
 shared::GpuCamera gpuCamera(const Camera& cam, int frame) {
   const CameraPose pose = cam.poseAt(frame);
   shared::GpuCamera c{};

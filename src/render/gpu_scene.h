@@ -16,6 +16,9 @@ namespace plume {
 // Throws InputError for more than GPU_MAX_LIGHTS lights.
 std::vector<shared::GpuLight> gpuLights(const Scene& scene);
 
+// The lights as the shaders read them: a texel buffer of uvec4, two per light (scene/bindings.glsl).
+gpu::TexelBuffer lightTexels(gpu::Context& ctx, const std::vector<shared::GpuLight>& lights);
+
 // Camera of `frame` (DESIGN §2: right = normalize(cross(forward, up)), row 0 at the top).
 shared::GpuCamera gpuCamera(const Camera& cam, int frame);
 bool sameCamera(const shared::GpuCamera& a, const shared::GpuCamera& b);  // every field but the padding

@@ -14,16 +14,12 @@
 namespace plume {
 namespace {
 
+// Each struct's bytes as 16-byte texels of a texel buffer (surface/texels.glsl reads them back).
 template <typename T>
-gpu::Buffer upload(gpu::Context& ctx, const std::vector<T>& data, const char* name) {
-  const VkDeviceSize bytes = std::max<VkDeviceSize>(sizeof(T), data.size() * sizeof(T));
-  if (bytes > ctx.limits().maxStorageBufferRange) {
-    throw InputError(strf("surfaces: the %s need %.0f MiB, more than this device's storage buffers hold (%.0f MiB)",
-                          name, double(bytes) / 1048576.0, double(ctx.limits().maxStorageBufferRange) / 1048576.0));
-  }
-  gpu::Buffer b(ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, name);
-  if (!data.empty()) b.upload(data.data(), data.size() * sizeof(T));
-  return b;
+gpu::TexelBuffer upload(gpu::Context& ctx, const std::vector<T>& data, const char* name) {
+  static_assert(sizeof(T) % 16 == 0, "a whole number of uvec4 texels");
+  return gpu::TexelBuffer(ctx, data.empty() ? nullptr : data.data(), data.size() * sizeof(T) / 16,
+                          VK_FORMAT_R32G32B32A32_UINT, name);
 }
 
 }  // namespace
@@ -157,6 +153,12 @@ GpuSurfaces::GpuSurfaces(gpu::Context& ctx, const Scene& scene) {
   logInfo(strf("surfaces: %zu triangles (%u emissive, light tree depth %d), BVH %zu nodes, %.1f bytes/triangle on the "
                "device; built in %.0f ms",
                mesh.triangleCount(), emitterCount_, lightTreeDepth_, stats_.nodes, stats_.bytesPerTriangle(), stats_.buildMs));
+}
+
+gpu::BindingTypes GpuSurfaces::bindingTypes(uint32_t shift) {
+  gpu::BindingTypes t;
+  for (uint32_t b = shared::BIND_BVH_NODES; b <= shared::BIND_EMITTERS; ++b) t.push_back({b + shift, gpu::BindingType::TexelBuffer});
+  return t;
 }
 
 void GpuSurfaces::bind(gpu::DescriptorSet& set, uint32_t shift) const {

@@ -35,12 +35,14 @@ LightTree buildLightTree(const std::vector<LightTreeEmitter>& emitters);
 class GpuSurfaces {
  public:
   // Throws InputError for bad surfaces (an OBJ's file and line, a scene key) and for a mesh
-  // larger than the device's storage buffers allow (the message names the buffer).
+  // larger than the device's texel buffers allow (the message names the buffer).
   GpuSurfaces(gpu::Context& ctx, const Scene& scene);
 
   // Binds BIND_BVH_NODES .. BIND_EMITTERS, each shifted by `shift` (surface/surfaces.glsl
   // PLUME_SURF_BINDING_SHIFT).
   void bind(gpu::DescriptorSet& set, uint32_t shift = 0) const;
+  // Their descriptor types: uniform texel buffers of uvec4 (surface/texels.glsl).
+  static gpu::BindingTypes bindingTypes(uint32_t shift = 0);
   // A rough estimate of the emitters' radiance scattered at p, phase-averaged:
   // sum of mean(Le) A max(cos, 0) / (4 pi r^2) over the emissive triangles (ReSTIR's light choice).
   double emitterPowerAt(glm::vec3 p) const;
@@ -49,7 +51,7 @@ class GpuSurfaces {
   double uploadMs() const { return uploadMs_; }
 
  private:
-  gpu::Buffer nodes_, bvhTriangles_, triangles_, materials_, emitters_;
+  gpu::TexelBuffer nodes_, bvhTriangles_, triangles_, materials_, emitters_;
   uint32_t emitterCount_ = 0;
   int lightTreeDepth_ = 0;
   struct EmitterSummary {

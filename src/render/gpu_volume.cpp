@@ -67,18 +67,15 @@ GpuVolumeResources::GpuVolumeResources(gpu::Context& ctx, const BakedVolume& bak
     const glm::ivec3 o = slotTexelOrigin(bake, bake.indirection[i]) / kBrickTexels;
     packed[i] = uint32_t(o.x) | uint32_t(o.y) << 10 | uint32_t(o.z) << 20;
   }
-  indirection_ = gpu::Buffer(ctx, packed.size() * 4, storage, "brick indirection");
-  indirection_.upload(packed.data(), packed.size() * 4);
-  majorants_ = gpu::Buffer(ctx, majorants.size() * 4, storage, "majorant hierarchy");
-  majorants_.upload(majorants.data(), majorants.size() * 4);
+  indirection_ = gpu::TexelBuffer(ctx, packed.data(), packed.size(), VK_FORMAT_R32_UINT, "brick indirection");
+  majorants_ = gpu::TexelBuffer(ctx, majorants.data(), majorants.size(), VK_FORMAT_R32_SFLOAT, "majorant hierarchy");
   // Per atlas slot 512 words: each voxel's mean and residual bound as two float16
   // (bake.h packedMeanField; volume/walk.glsl).
   std::vector<uint32_t> coarse = packedMeanField(bake);
   // Baked without it (a path-traced render): a placeholder, so that binding sets stay valid.
   hasMeanField_ = !coarse.empty();
   if (coarse.empty()) coarse.assign(4, 0u);
-  coarse_ = gpu::Buffer(ctx, coarse.size() * 4, storage, "mean field");
-  coarse_.upload(coarse.data(), coarse.size() * 4);
+  coarse_ = gpu::TexelBuffer(ctx, coarse.data(), coarse.size(), VK_FORMAT_R32_UINT, "mean field");
   counters_ = gpu::Buffer(ctx, shared::KC_WORDS * 4, storage, "tracking counters");
   resetCounters();
   bytes_ = sizeof(params_) + atlasBytes + bake.indirection.size() * 4 + majorants.size() * 4 + coarse.size() * 4;
@@ -97,8 +94,7 @@ GpuVolumeResources::GpuVolumeResources(gpu::Context& ctx, const BakedVolume& bak
     emissionAtlas_.upload(bake.emissionF32.data(), bake.emissionF32.size() * 4);
     // The same for every volume: integrated once per process (4096 spectral integrals), not per frame.
     static const std::vector<glm::vec4> table = blackbodyTable();
-    blackbody_ = gpu::Buffer(ctx, table.size() * sizeof(glm::vec4), storage, "blackbody table");
-    blackbody_.upload(table.data(), table.size() * sizeof(glm::vec4));
+    blackbody_ = gpu::TexelBuffer(ctx, table.data(), table.size(), VK_FORMAT_R32G32B32A32_SFLOAT, "blackbody table");
     bytes_ += bake.emissionF32.size() * 4 + table.size() * sizeof(glm::vec4);
   }
 }
@@ -108,6 +104,25 @@ void GpuVolumeResources::setDensityScale(float densityScale) {
   params_.densityScale = densityScale;
   paramBuffer_.upload(&params_, sizeof(params_));
   serial_ = newSerial();  // another medium: renderers must not take it for the one they rendered
+}
+
+gpu::BindingTypes GpuVolumeResources::bindingTypes(bool restir, bool emission) {
+  using gpu::BindingType;
+  using namespace shared;
+  gpu::BindingTypes t = {{BIND_ATLAS, BindingType::SampledImage},
+                         {BIND_INDIRECTION, BindingType::TexelBuffer},
+                         {BIND_MAJORANTS, BindingType::TexelBuffer}};
+  if (restir) {
+    t.insert(t.end(), {{BIND_MEAN_FIELD, BindingType::TexelBuffer},
+                       {BIND_PREV_ATLAS, BindingType::SampledImage},
+                       {BIND_PREV_INDIRECTION, BindingType::TexelBuffer},
+                       {BIND_PREV_MEAN_FIELD, BindingType::TexelBuffer}});
+  }
+  if (emission) {
+    t.insert(t.end(), {{BIND_EMISSION_ATLAS, BindingType::SampledImage}, {BIND_BLACKBODY, BindingType::TexelBuffer}});
+    if (restir) t.push_back({BIND_PREV_EMISSION_ATLAS, BindingType::SampledImage});
+  }
+  return t;
 }
 
 void GpuVolumeResources::bind(gpu::DescriptorSet& set) const {

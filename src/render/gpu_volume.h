@@ -1,5 +1,5 @@
 // The baked volume on the device (DESIGN §3): the brick atlas as a 3D texture (R16F or R32F),
-// the indirection and the majorant hierarchy as storage buffers, ReSTIR's voxel mean field, and
+// the indirection and the majorant hierarchy as texel buffers, ReSTIR's voxel mean field, and
 // the GpuVolume parameter block. Bound by the names of shaders/shared/bindings.h
 // (shaders/volume/bindings.glsl).
 #pragma once
@@ -26,6 +26,12 @@ class GpuVolumeResources {
   // and with an emission channel the emission atlas and the blackbody table (BIND_EMISSION_ATLAS,
   // BIND_BLACKBODY).
   void bind(gpu::DescriptorSet& set) const;
+  // The descriptor types of the volume's bindings in a pass's table (the rest, the parameter
+  // blocks among them, are storage buffers): the atlases sampled images, the indirections, the
+  // majorants, the mean fields and the blackbody table uniform texel buffers (lanes read them at
+  // places of their own in the walks' loops: docs/architecture.md, "Descriptor kinds"). `restir`: with the mean field
+  // and the previous frame's volume (shaders/restir/bindings.glsl); `emission`: with the emission.
+  static gpu::BindingTypes bindingTypes(bool restir, bool emission);
   // Binds ReSTIR's mean field (BIND_MEAN_FIELD): 512 words per atlas slot (slot index
   // x + X * (y + Y * z) of the packed slot coordinates), each voxel's mean and residual bound as
   // two float16 (bake.h packedMeanField).
@@ -57,12 +63,12 @@ class GpuVolumeResources {
   bool hasMeanField_ = false;
   gpu::Buffer paramBuffer_;
   gpu::Image3D atlas_;
-  gpu::Buffer indirection_;
-  gpu::Buffer majorants_;
+  gpu::TexelBuffer indirection_;
+  gpu::TexelBuffer majorants_;
   gpu::Buffer counters_;
-  gpu::Buffer coarse_;
+  gpu::TexelBuffer coarse_;
   gpu::Image3D emissionAtlas_;  // with an emission channel only
-  gpu::Buffer blackbody_;
+  gpu::TexelBuffer blackbody_;
   bool hasEmission_ = false;
   uint64_t bytes_ = 0;
   uint64_t serial_ = 0;

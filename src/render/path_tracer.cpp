@@ -27,8 +27,7 @@ PathTracer::PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const S
   const size_t pixels = size_t(scene.camera.width) * scene.camera.height;
   frameBuffer_ = gpu::Buffer(ctx, sizeof(shared::GpuFrame), storage, "frame parameters");
   std::vector<shared::GpuLight> lights = gpuLights(scene);
-  lightBuffer_ = gpu::Buffer(ctx, lights.size() * sizeof(shared::GpuLight), storage, "lights");
-  lightBuffer_.upload(lights.data(), lights.size() * sizeof(shared::GpuLight));
+  lightBuffer_ = lightTexels(ctx, lights);
   accum_ = gpu::Buffer(ctx, pixels * 2 * sizeof(glm::vec4), storage, "accumulation");
   slots_ = uint32_t(std::min<size_t>(pixels, kMaxSlots));
   paths_ = gpu::Buffer(ctx, size_t(slots_) * shared::PT_PATH_BYTES, storage, "path slots");
@@ -38,6 +37,17 @@ PathTracer::PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const S
   queue_ = makePass("passes/pt_queue.comp", none, "pt queues", false);
   resolve_ = makePass("passes/pt_resolve.comp", none, "pt resolve", false);
   active_ = &tracking(false);
+}
+
+// The descriptor types of the kernels that walk the scene (the rest are storage buffers).
+gpu::BindingTypes PathTracer::volumeTypes() const {
+  gpu::BindingTypes t = GpuVolumeResources::bindingTypes(false, features_.emission);
+  t.push_back({shared::BIND_LIGHTS, gpu::BindingType::TexelBuffer});
+  if (features_.surfaces) {
+    const gpu::BindingTypes s = GpuSurfaces::bindingTypes();
+    t.insert(t.end(), s.begin(), s.end());
+  }
+  return t;
 }
 
 std::unique_ptr<gpu::ComputePass> PathTracer::makePass(const std::string& file, const gpu::ShaderDefines& defines,
@@ -50,10 +60,7 @@ std::unique_ptr<gpu::ComputePass> PathTracer::makePass(const std::string& file, 
   // where the scene emits.
   std::vector<BindingType> table =
       !volumeTable ? gpu::bindingTable(shared::BIND_PT_WAVE + 1, {})
-      : features_.emission
-          ? gpu::bindingTable(shared::BIND_BLACKBODY + 1, {{shared::BIND_ATLAS, BindingType::SampledImage},
-                                                            {shared::BIND_EMISSION_ATLAS, BindingType::SampledImage}})
-          : gpu::bindingTable(shared::BIND_ENV_MAP + 1, {{shared::BIND_ATLAS, BindingType::SampledImage}});
+      : gpu::bindingTable(features_.emission ? shared::BIND_BLACKBODY + 1 : shared::BIND_ENV_MAP + 1, volumeTypes());
   auto pass = std::make_unique<gpu::ComputePass>(ctx_, compiler_.compile(file, all), std::move(table),
                                                  uint32_t(sizeof(shared::PtPush)), name,
                                                  glm::uvec3(shared::PT_WAVE_GROUP, 1, 1));

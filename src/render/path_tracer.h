@@ -55,6 +55,7 @@ class PathTracer {
     std::unique_ptr<gpu::ComputePass> extend, shade;
   };
   Tracking& tracking(bool skipEmpty);
+  gpu::BindingTypes volumeTypes() const;
   std::unique_ptr<gpu::ComputePass> makePass(const std::string& file, const gpu::ShaderDefines& defines,
                                              const std::string& name, bool volumeTable);
   // Traces samples [sampleBase, sampleBase + samples) of pixels [pixelBegin, pixelBegin + pixels)
@@ -68,7 +69,8 @@ class PathTracer {
   std::unique_ptr<gpu::ComputePass> queue_, resolve_;
   bool skipEmpty_ = false;
   gpu::GpuTimer timer_;
-  gpu::Buffer frameBuffer_, lightBuffer_, accum_;
+  gpu::Buffer frameBuffer_, accum_;
+  gpu::TexelBuffer lightBuffer_;
   gpu::Buffer paths_, queues_, wave_;  // the wavefront's path slots, queues and PtWave
   uint32_t slots_ = 0;                 // path slots allocated
   shared::GpuFrame frame_{};

@@ -128,14 +128,13 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   const uint32_t count = features_.surfaces ? shared::RS_SURFACE_BINDING_COUNT
                          : features_.emission ? shared::EMISSION_BINDING_COUNT
                                               : shared::RS_BINDING_COUNT;
-  const std::vector<BindingType> bindings =
-      features_.emission
-          ? gpu::bindingTable(count,
-                              {{shared::BIND_ATLAS, BindingType::SampledImage}, {shared::BIND_PREV_ATLAS, BindingType::SampledImage},
-                               {shared::BIND_EMISSION_ATLAS, BindingType::SampledImage},
-                               {shared::BIND_PREV_EMISSION_ATLAS, BindingType::SampledImage}})
-          : gpu::bindingTable(count, {{shared::BIND_ATLAS, BindingType::SampledImage},
-                                                         {shared::BIND_PREV_ATLAS, BindingType::SampledImage}});
+  gpu::BindingTypes types = GpuVolumeResources::bindingTypes(true, features_.emission);
+  types.push_back({shared::BIND_LIGHTS, BindingType::TexelBuffer});
+  if (features_.surfaces) {
+    const gpu::BindingTypes s = GpuSurfaces::bindingTypes(shared::RS_SURF_BINDING_SHIFT);
+    types.insert(types.end(), s.begin(), s.end());
+  }
+  const std::vector<BindingType> bindings = gpu::bindingTable(count, types);
   const gpu::ShaderDefines defines = features_.defines();
   const std::string variant = " [" + features_.name() + "]";
   // Each pass is compiled with only the code its options use (MIS kind, temporal or spatial,
@@ -173,8 +172,7 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   const uint32_t stride = uint32_t(std::max(1, vertices - 1));
   frameBuffer_ = gpu::Buffer(ctx, sizeof(shared::GpuFrame), storage, "frame parameters");
   const std::vector<shared::GpuLight> lights = gpuLights(scene);
-  lightBuffer_ = gpu::Buffer(ctx, lights.size() * sizeof(shared::GpuLight), storage, "lights");
-  lightBuffer_.upload(lights.data(), lights.size() * sizeof(shared::GpuLight));
+  lightBuffer_ = lightTexels(ctx, lights);
   const size_t choices = std::max(lights.size(), scene.lights.size() + (features_.emitters ? 1 : 0));
   lightChoice_ = gpu::Buffer(ctx, choices * sizeof(shared::GpuLightChoice), storage, "light choice");
   paramBuffer_ = gpu::Buffer(ctx, sizeof(shared::RestirParams), storage, "restir parameters");

@@ -97,7 +97,8 @@ class Restir {
   std::unique_ptr<gpu::ComputePass> tail_;  // final shading's tail (null without one)
   uint32_t tailDispatches_ = 0;             // its dispatches per frame at most (max_bounces' walk)
   gpu::GpuTimer timer_;
-  gpu::Buffer frameBuffer_, lightBuffer_, lightChoice_, paramBuffer_, reservoirs_, paths_, bounces_, output_, counters_;
+  gpu::TexelBuffer lightBuffer_;
+  gpu::Buffer frameBuffer_, lightChoice_, paramBuffer_, reservoirs_, paths_, bounces_, output_, counters_;
   shared::GpuFrame frame_{};
   shared::RestirParams params_{};
   uint32_t history_ = 0;
