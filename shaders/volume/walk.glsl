@@ -350,6 +350,112 @@ void vol_track_event(uint tracker, inout VolTrack s, uint v, float scale, vec3 p
 #endif
 }
 
+#ifdef PLUME_KERNEL_COUNTERS
+#define VOL_KC_PARAM , inout VolKc kc
+#define VOL_KC_ARG , kc
+#else
+#define VOL_KC_PARAM
+#define VOL_KC_ARG
+#endif
+
+// The walk's loops, two forms of the same draws in the same order (bit-identical results). A SIMD
+// back end runs a loop's whole body on every iteration while any lane needs it
+// (../shared/docs/LAVAPIPE.md), so which code shares a loop matters:
+//  - by collision (the majorant field: delta and ratio tracking): the outer loop makes one
+//    tentative collision, one density lookup, per iteration; the inner loop takes the draws and
+//    cheap majorant segments up to it and holds no lookup. The lookup then runs once per
+//    collision of the subgroup instead of once per draw (path tracer extension 11 % faster);
+//  - by segment (the mean field: ReSTIR's trackers): the outer loop takes a segment, whose voxel
+//    DDA, exact voxels and closed forms are heavy, the inner loop its draws and their cheap
+//    events (in the first form ReSTIR's shading was 1.7x slower).
+// (Majorant fields only: no exact voxels here.)
+void vol_track_by_collision(uint tracker, uint field, uint v, inout VolTrack s, inout VolWalk w, float scale, vec3 o,
+                            vec3 d, inout uint steps, inout RngState rng VOL_KC_PARAM) {
+  float a = 0.0f;
+  float b = 0.0f;
+  vec2 value = vec2(0.0f);
+  float mu = 0.0f;
+  float t = 0.0f;
+  bool inSegment = false;  // drawing tentative collisions in [a, b) at rate mu
+  for (;;) {
+    bool found = false;
+    uvec4 h = uvec4(0u);
+    for (;;) {
+      if (inSegment) {
+        if (++steps > VOL_MAX_STEPS) {
+          s.stop = true;
+          break;
+        }
+#ifdef PLUME_KERNEL_COUNTERS
+        vol_kc_step(kc);
+#endif
+        h = rng_next4(rng);
+        t -= log(1.0f - rng_to_float(h.x)) / mu;
+        if (t < b) {
+          found = true;
+          break;
+        }
+        inSegment = false;
+      } else {
+        // A segment is entered only where the tracker still needs one (as by_segment does).
+        if (!vol_track_alive(tracker, s) || !vol_walk_next(field, w, a, b, value)) break;
+#ifdef PLUME_KERNEL_COUNTERS
+        vol_kc_segment(kc);
+#endif
+        mu = vol_track_segment(tracker, s, a, b, value);
+        t = a;
+        inSegment = mu > 0.0f;
+      }
+    }
+    if (!found) break;
+#ifdef PLUME_KERNEL_COUNTERS
+    vol_kc_lookup(kc);
+#endif
+    vol_track_event(tracker, s, v, scale, o + t * d, t, mu, value, rng_to_float(h.y), rng);
+    if (s.stop) break;
+  }
+}
+
+void vol_track_by_segment(uint tracker, uint field, uint v, inout VolTrack s, inout VolWalk w, float scale, vec3 o,
+                          vec3 d, inout uint steps, inout RngState rng VOL_KC_PARAM) {
+  float a;
+  float b;
+  vec2 value;
+  while (vol_track_alive(tracker, s) && vol_walk_next(field, w, a, b, value)) {
+#ifdef PLUME_KERNEL_COUNTERS
+    vol_kc_segment(kc);
+#endif
+    float mu;
+#if defined(PLUME_VOL_MEAN_FIELD) || defined(PLUME_VOL_PREVIOUS)
+    if (field == VOL_FIELD_MEAN && w.exact) {
+      mu = vol_track_exact(tracker, s, w, scale, a, b);
+    } else
+#endif
+    {
+      mu = vol_track_segment(tracker, s, a, b, value);
+    }
+    if (!(mu > 0.0f)) continue;
+    float t = a;
+    for (;;) {
+      if (++steps > VOL_MAX_STEPS) {
+        s.stop = true;
+        break;
+      }
+#ifdef PLUME_KERNEL_COUNTERS
+      vol_kc_step(kc);
+#endif
+      uvec4 h = rng_next4(rng);
+      t -= log(1.0f - rng_to_float(h.x)) / mu;
+      if (!(t < b)) break;
+#ifdef PLUME_KERNEL_COUNTERS
+      vol_kc_lookup(kc);
+#endif
+      vol_track_event(tracker, s, v, scale, o + t * d, t, mu, value, rng_to_float(h.y), rng);
+      if (s.stop) break;
+    }
+  }
+}
+
 // The walk. `init`: the tracker's starting value (RATIO, RESIDUAL 1; TAU 0; SAMPLE the optical
 // depth to the collision). Tentative collisions restart at each segment's entry (exponential
 // steps are memoryless); each step draws one rng_next4 (its x: the step, its y: the event's u).
@@ -374,60 +480,10 @@ VolTrack vol_track(uint tracker, uint v, vec3 xWorld, vec3 wWorld, float tMax, f
   VolKc kc = vol_kc_start();
 #endif
   float scale = vol_scale(v);  // sigma_t = scale * d, read once per walk
-  float a = 0.0f;
-  float b = 0.0f;
-  vec2 value = vec2(0.0f);
-  float mu = 0.0f;
-  float t = 0.0f;
-  bool inSegment = false;  // drawing tentative collisions in [a, b) at rate mu
-  // The outer loop makes one tentative collision (one lookup) per iteration; the inner loop takes
-  // the draws and segments up to it and holds no lookup. A SIMD back end runs a loop's whole body
-  // on every iteration while any lane needs it (../shared/docs/LAVAPIPE.md), so the lookup now
-  // runs once per collision of the subgroup instead of once per draw (measured on lavapipe:
-  // extension 11 % faster, the same draws in the same order: bit-identical images).
-  for (;;) {
-    bool found = false;
-    uvec4 h = uvec4(0u);
-    for (;;) {
-      if (inSegment) {
-        if (++steps > VOL_MAX_STEPS) {
-          s.stop = true;
-          break;
-        }
-#ifdef PLUME_KERNEL_COUNTERS
-        vol_kc_step(kc);
-#endif
-        h = rng_next4(rng);
-        t -= log(1.0f - rng_to_float(h.x)) / mu;
-        if (t < b) {
-          found = true;
-          break;
-        }
-        inSegment = false;
-      } else {
-        // As before a segment is entered: only where the tracker still needs one.
-        if (!vol_track_alive(tracker, s) || !vol_walk_next(field, w, a, b, value)) break;
-#ifdef PLUME_KERNEL_COUNTERS
-        vol_kc_segment(kc);
-#endif
-#if defined(PLUME_VOL_MEAN_FIELD) || defined(PLUME_VOL_PREVIOUS)
-        if (field == VOL_FIELD_MEAN && w.exact) {
-          mu = vol_track_exact(tracker, s, w, scale, a, b);
-        } else
-#endif
-        {
-          mu = vol_track_segment(tracker, s, a, b, value);
-        }
-        t = a;
-        inSegment = mu > 0.0f;
-      }
-    }
-    if (!found) break;
-#ifdef PLUME_KERNEL_COUNTERS
-    vol_kc_lookup(kc);
-#endif
-    vol_track_event(tracker, s, v, scale, o + t * d, t, mu, value, rng_to_float(h.y), rng);
-    if (s.stop) break;
+  if (field == VOL_FIELD_MAJORANT) {
+    vol_track_by_collision(tracker, field, v, s, w, scale, o, d, steps, rng VOL_KC_ARG);
+  } else {
+    vol_track_by_segment(tracker, field, v, s, w, scale, o, d, steps, rng VOL_KC_ARG);
   }
   if (steps > VOL_MAX_STEPS) atomicAdd(volCounters[0], 1u);  // truncated: counted, never silent
 #ifdef PLUME_KERNEL_COUNTERS
