@@ -1,6 +1,7 @@
 // Tier c (DESIGN §7): the shared headers compiled as GLSL (run on the Vulkan device) and as C++
 // give the same results: RNG streams bit-exact; phase, sampling and the baked trilinear density
 // to float rounding.
+#include "core/error.h"
 #include "gpu/pipeline.h"
 #include "media/vdb_loader.h"
 #include "render/gpu_volume.h"
@@ -89,4 +90,19 @@ TEST_F(GpuShared, GlslAndCppAgree) {
   EXPECT_EQ(rngMismatches, 0) << "RNG streams must be bit-exact";
   EXPECT_EQ(floatMismatches, 0);
   EXPECT_EQ(densityMismatches, 0) << "worst density difference " << worstDensity;
+}
+
+// A texel buffer longer than the device allows is bad input (its size follows from the scene),
+// refused before anything is allocated, with the buffer named; at the limit it is accepted.
+TEST_F(GpuShared, TexelBufferBeyondTheDeviceLimitIsABadInputThatNamesIt) {
+  const size_t limit = ctx().limits().maxTexelBufferElements;
+  try {
+    gpu::TexelBuffer b(ctx(), nullptr, limit + 1, VK_FORMAT_R32_UINT, "the test's mean field");
+    FAIL() << "no error for " << limit + 1 << " elements";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("the test's mean field"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(std::to_string(limit)), std::string::npos) << e.what();
+  }
+  gpu::TexelBuffer small(ctx(), nullptr, 16, VK_FORMAT_R32G32B32A32_UINT, "a small one");
+  EXPECT_NE(small.view(), VkBufferView(VK_NULL_HANDLE));
 }

@@ -4,6 +4,8 @@
 #include "core/log.h"
 #include "gpu/check.h"
 
+#include <algorithm>
+
 namespace plume::gpu {
 namespace {
 
@@ -91,44 +93,36 @@ DescriptorSet::~DescriptorSet() {
   if (pool_) vkDestroyDescriptorPool(ctx_.device(), pool_, nullptr);
 }
 
-void DescriptorSet::bind(uint32_t binding, const Buffer& buffer) {
+// One descriptor at `binding`, whose declared type must be one of `allowed` (one info is given).
+void DescriptorSet::write(uint32_t binding, std::initializer_list<BindingType> allowed, const VkDescriptorImageInfo* image,
+                          const VkDescriptorBufferInfo* buffer, const VkBufferView* texels) {
   PLUME_CHECK(binding < pipeline_.bindings().size());
-  PLUME_CHECK(pipeline_.bindings()[binding] == BindingType::StorageBuffer ||
-              pipeline_.bindings()[binding] == BindingType::UniformBuffer);
-  VkDescriptorBufferInfo bi{buffer.handle(), 0, VK_WHOLE_SIZE};
+  const BindingType type = pipeline_.bindings()[binding];
+  PLUME_CHECK(std::find(allowed.begin(), allowed.end(), type) != allowed.end());
   VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
   w.dstSet = set_;
   w.dstBinding = binding;
   w.descriptorCount = 1;
-  w.descriptorType = descriptorType(pipeline_.bindings()[binding]);
-  w.pBufferInfo = &bi;
+  w.descriptorType = descriptorType(type);
+  w.pImageInfo = image;
+  w.pBufferInfo = buffer;
+  w.pTexelBufferView = texels;
   vkUpdateDescriptorSets(ctx_.device(), 1, &w, 0, nullptr);
+}
+
+void DescriptorSet::bind(uint32_t binding, const Buffer& buffer) {
+  const VkDescriptorBufferInfo bi{buffer.handle(), 0, VK_WHOLE_SIZE};
+  write(binding, {BindingType::StorageBuffer, BindingType::UniformBuffer}, nullptr, &bi, nullptr);
 }
 
 void DescriptorSet::bind(uint32_t binding, const Image3D& image) {
-  PLUME_CHECK(binding < pipeline_.bindings().size());
-  PLUME_CHECK(pipeline_.bindings()[binding] == BindingType::SampledImage);
-  VkDescriptorImageInfo ii{image.sampler(), image.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-  VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-  w.dstSet = set_;
-  w.dstBinding = binding;
-  w.descriptorCount = 1;
-  w.descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-  w.pImageInfo = &ii;
-  vkUpdateDescriptorSets(ctx_.device(), 1, &w, 0, nullptr);
+  const VkDescriptorImageInfo ii{image.sampler(), image.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+  write(binding, {BindingType::SampledImage}, &ii, nullptr, nullptr);
 }
 
 void DescriptorSet::bind(uint32_t binding, const TexelBuffer& buffer) {
-  PLUME_CHECK(binding < pipeline_.bindings().size());
-  PLUME_CHECK(pipeline_.bindings()[binding] == BindingType::TexelBuffer);
-  VkBufferView view = buffer.view();
-  VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-  w.dstSet = set_;
-  w.dstBinding = binding;
-  w.descriptorCount = 1;
-  w.descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
-  w.pTexelBufferView = &view;
-  vkUpdateDescriptorSets(ctx_.device(), 1, &w, 0, nullptr);
+  const VkBufferView view = buffer.view();
+  write(binding, {BindingType::TexelBuffer}, nullptr, nullptr, &view);
 }
 
 GpuTimer::GpuTimer(Context& ctx, uint32_t maxScopes) : ctx_(ctx), maxScopes_(maxScopes) {

@@ -64,6 +64,8 @@ class DescriptorSet {
   VkDescriptorSet handle() const { return set_; }
 
  private:
+  void write(uint32_t binding, std::initializer_list<BindingType> allowed, const VkDescriptorImageInfo* image,
+             const VkDescriptorBufferInfo* buffer, const VkBufferView* texels);
   Context& ctx_;
   const ComputePipeline& pipeline_;
   VkDescriptorPool pool_ = VK_NULL_HANDLE;
