@@ -24,7 +24,8 @@
 //   [0, 3WH)                     texel radiance RGB (times the light's `scale`), row-major
 //   [3WH, 3WH + H + 1)           marginal CDF over rows
 //   [3WH + H + 1, + H (W + 1))   per row r, the conditional CDF over its columns
-// GLSL reads the global `envData[]` (scene/bindings.glsl); C++ passes a pointer (ENV_DATA_*).
+// GLSL reads element i as ENV_DATA(i) (scene/bindings.glsl: a texel fetch; by default a global
+// `envData[]`); C++ passes a pointer (ENV_DATA_*).
 #ifndef PLUME_SHARED_ENVMAP_H
 #define PLUME_SHARED_ENVMAP_H
 
@@ -37,6 +38,9 @@
 #else
 #define ENV_DATA_PARAM
 #define ENV_DATA_ARG
+#endif
+#ifndef ENV_DATA
+#define ENV_DATA(i) envData[i]
 #endif
 
 PLUME_NS_BEGIN
@@ -87,7 +91,7 @@ PLUME_FN uvec2 env_texel(GpuEnvMap m, vec2 uv) {
 PLUME_FN vec3 env_radiance(ENV_DATA_PARAM GpuEnvMap m, vec3 w) {
   uvec2 t = env_texel(m, env_local_uv(env_to_local(m, w)));
   uint i = 3u * (t.y * m.width + t.x);
-  return vec3(envData[i], envData[i + 1u], envData[i + 2u]);
+  return vec3(ENV_DATA(i), ENV_DATA(i + 1u), ENV_DATA(i + 2u));
 }
 
 // The interval i in [0, n) of the CDF cdf[offset .. offset + n] with cdf[i] <= u < cdf[i + 1]
@@ -97,7 +101,7 @@ PLUME_FN uint env_find_interval(ENV_DATA_PARAM uint offset, uint n, float u) {
   uint hi = n;
   while (lo + 1u < hi) {
     uint mid = (lo + hi) / 2u;
-    if (envData[offset + mid] <= u) {
+    if (ENV_DATA(offset + mid) <= u) {
       lo = mid;
     } else {
       hi = mid;
@@ -110,7 +114,7 @@ PLUME_FN uint env_find_interval(ENV_DATA_PARAM uint offset, uint n, float u) {
 PLUME_FN float env_texel_probability(ENV_DATA_PARAM GpuEnvMap m, uvec2 t) {
   uint mo = env_marginal_offset(m) + t.y;
   uint co = env_conditional_offset(m, t.y) + t.x;
-  return (envData[mo + 1u] - envData[mo]) * (envData[co + 1u] - envData[co]);
+  return (ENV_DATA(mo + 1u) - ENV_DATA(mo)) * (ENV_DATA(co + 1u) - ENV_DATA(co));
 }
 
 // pdf per solid angle of drawing world direction w (unit); 0 at the poles (sin theta = 0).
@@ -128,12 +132,12 @@ PLUME_FN vec3 env_sample(ENV_DATA_PARAM GpuEnvMap m, vec2 u) {
   float u1 = min(u.y, 0.99999994f);
   uint mo = env_marginal_offset(m);
   uint r = env_find_interval(ENV_DATA_ARG mo, m.height, u0);
-  float c0 = envData[mo + r];
-  float dv = (u0 - c0) / (envData[mo + r + 1u] - c0);
+  float c0 = ENV_DATA(mo + r);
+  float dv = (u0 - c0) / (ENV_DATA(mo + r + 1u) - c0);
   uint co = env_conditional_offset(m, r);
   uint c = env_find_interval(ENV_DATA_ARG co, m.width, u1);
-  float k0 = envData[co + c];
-  float du = (u1 - k0) / (envData[co + c + 1u] - k0);
+  float k0 = ENV_DATA(co + c);
+  float du = (u1 - k0) / (ENV_DATA(co + c + 1u) - k0);
   // (Rounding may put (c + du) / W on the next texel's edge for du within ~1e-7 of 1: a set of
   // measure ~1e-7 whose pdf is then the neighbour's.)
   float fu = (float(c) + clamp(du, 0.0f, 1.0f)) / float(m.width);

@@ -105,7 +105,7 @@ struct GpuFrame {
   uint rrStartBounce;    // first bounce at which Russian roulette may end a path
   uint lightCount;
   uint loopProbe;        // 2: the trip count of the driver-loop-limit probe (volume/loop_guard.glsl)
-  uint emitterCount;     // entries of the emissive triangles' alias table (surface/surfaces.glsl)
+  uint pad1;
   uint pad2;
   uint pad3;
 };
@@ -138,7 +138,6 @@ static_assert(offsetof(plume::shared::GpuFrame, albedo) == 64, "GpuFrame layout"
 static_assert(offsetof(plume::shared::GpuFrame, size) == 80, "GpuFrame layout");
 static_assert(offsetof(plume::shared::GpuFrame, maxBounces) == 88, "GpuFrame layout");
 static_assert(offsetof(plume::shared::GpuFrame, seed) == 92, "GpuFrame layout");
-static_assert(offsetof(plume::shared::GpuFrame, emitterCount) == 116, "GpuFrame layout");
 static_assert(sizeof(plume::shared::GpuFrame) == 8 * 16, "GpuFrame layout");
 #endif
 

@@ -23,7 +23,7 @@ struct EnvironmentMapImage {
 // The most texels an estimator can take, and the device limit that sets it (named in errors).
 struct EnvironmentMapLimit {
   uint64_t maxTexels = UINT64_MAX;
-  std::string what;  // e.g. "the device's maxStorageBufferRange (134217728 bytes)"
+  std::string what;  // e.g. "the device's maxTexelBufferElements (134217728 words, ...)"
 };
 
 // Reads and checks the map of scene key `key` (e.g. "scene.json: lights[0].map"). Throws

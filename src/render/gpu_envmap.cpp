@@ -8,6 +8,8 @@
 #include <glm/glm.hpp>
 
 #include <cmath>
+#include <cstring>
+#include <vector>
 
 namespace plume {
 
@@ -83,10 +85,12 @@ EnvMapData buildEnvMapData(const EnvironmentMapImage& image, float scale, glm::v
 
 EnvironmentMapLimit envMapLimit(const VkPhysicalDeviceLimits& limits) {
   EnvironmentMapLimit l;
-  const uint64_t range = limits.maxStorageBufferRange;
-  l.maxTexels = range > sizeof(shared::GpuEnvMap) ? (range - sizeof(shared::GpuEnvMap)) / kEnvMapBytesPerTexel : 0;
-  l.what = strf("the device's maxStorageBufferRange (%llu bytes, at %llu bytes per texel)",
-                (unsigned long long)range, (unsigned long long)kEnvMapBytesPerTexel);
+  // One texel buffer of 32-bit words: the header, then the data (scene/bindings.glsl).
+  const uint64_t words = limits.maxTexelBufferElements;
+  const uint64_t header = sizeof(shared::GpuEnvMap) / 4;
+  l.maxTexels = words > header ? (words - header) / (kEnvMapBytesPerTexel / 4) : 0;
+  l.what = strf("the device's maxTexelBufferElements (%llu words, at %llu words per texel)", (unsigned long long)words,
+                (unsigned long long)(kEnvMapBytesPerTexel / 4));
   return l;
 }
 
@@ -108,10 +112,11 @@ GpuEnvironmentMap::GpuEnvironmentMap(gpu::Context& ctx, const Scene& scene) {
     black.texels.assign(2, glm::vec3(0.0f));
     d = buildEnvMapData(black, 1.0f, glm::vec3(0, 1, 0), 0.0f);
   }
-  const size_t bytes = sizeof(shared::GpuEnvMap) + d.data.size() * sizeof(float);
-  buffer_ = gpu::Buffer(ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "environment map");
-  buffer_.upload(&d.header, sizeof(d.header));
-  buffer_.upload(d.data.data(), d.data.size() * sizeof(float), sizeof(d.header));
+  static_assert(sizeof(shared::GpuEnvMap) == 64, "scene/bindings.glsl reads 16 header words");
+  std::vector<uint32_t> words(sizeof(d.header) / 4 + d.data.size());
+  std::memcpy(words.data(), &d.header, sizeof(d.header));
+  std::memcpy(words.data() + sizeof(d.header) / 4, d.data.data(), d.data.size() * sizeof(float));
+  buffer_ = gpu::TexelBuffer(ctx, words.data(), words.size(), VK_FORMAT_R32_UINT, "environment map");
 }
 
 void GpuEnvironmentMap::bind(gpu::DescriptorSet& set) const { set.bind(shared::BIND_ENV_MAP, buffer_); }

@@ -1,6 +1,7 @@
 // The scene's environment map for the GPU estimators (DESIGN §2; shaders/shared/envmap.h): the
 // texels (radiance times the light's `scale`) and the sampling CDFs built on the host, uploaded
-// as one storage buffer behind a GpuEnvMap header and bound at BIND_ENV_MAP. A scene without a
+// as one texel buffer of 32-bit words (the GpuEnvMap header, then the data) bound at
+// BIND_ENV_MAP. A scene without a
 // map gets a one-texel black placeholder (its variants never read it).
 #pragma once
 
@@ -42,7 +43,7 @@ class GpuEnvironmentMap {
   glm::vec3 meanRadiance() const { return meanRadiance_; }
 
  private:
-  gpu::Buffer buffer_;
+  gpu::TexelBuffer buffer_;
   bool present_ = false;
   glm::vec3 meanRadiance_{0};
 };

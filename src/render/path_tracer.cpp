@@ -43,6 +43,7 @@ PathTracer::PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const S
 gpu::BindingTypes PathTracer::volumeTypes() const {
   gpu::BindingTypes t = GpuVolumeResources::bindingTypes(false, features_.emission);
   t.push_back({shared::BIND_LIGHTS, gpu::BindingType::TexelBuffer});
+  t.push_back({shared::BIND_ENV_MAP, gpu::BindingType::TexelBuffer});
   if (features_.surfaces) {
     const gpu::BindingTypes s = GpuSurfaces::bindingTypes();
     t.insert(t.end(), s.begin(), s.end());
@@ -102,7 +103,6 @@ void PathTracer::setVolume(const GpuVolumeResources& volume) {
 
 void PathTracer::beginFrame(int frame) {
   frame_ = gpuFrame(scene_, frame, uint32_t(scene_.render.seed), uint32_t(frame));
-  frame_.emitterCount = surfaces_ ? surfaces_->emitterCount() : 0u;
   accum_.fillZero();
   samples_ = 0;
 }

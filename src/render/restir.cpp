@@ -130,6 +130,7 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
                                               : shared::RS_BINDING_COUNT;
   gpu::BindingTypes types = GpuVolumeResources::bindingTypes(true, features_.emission);
   types.push_back({shared::BIND_LIGHTS, BindingType::TexelBuffer});
+  types.push_back({shared::BIND_ENV_MAP, BindingType::TexelBuffer});
   if (features_.surfaces) {
     const gpu::BindingTypes s = GpuSurfaces::bindingTypes(shared::RS_SURF_BINDING_SHIFT);
     types.insert(types.end(), s.begin(), s.end());
@@ -240,7 +241,6 @@ void Restir::resetHistory() { hasHistory_ = false; }
 
 void Restir::fillFrame(int frame, uint32_t sequence, uint32_t key) {
   frame_ = gpuFrame(scene_, frame, uint32_t(scene_.render.seed) + 0x9E3779B9u * sequence, key);
-  frame_.emitterCount = surfaces_ ? surfaces_->emitterCount() : 0u;
   const shared::GpuCamera& cam = frame_.camera;
   const bool history = hasHistory_ && options_.historyCap > 0 && prevSequence_ == sequence;
   if (history) params_.prevCamera = prevCam_;
