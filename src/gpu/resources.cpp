@@ -116,6 +116,7 @@ TexelBuffer::TexelBuffer(Context& ctx, const void* data, size_t count, VkFormat 
   PLUME_CHECK(format == VK_FORMAT_R32_SFLOAT || format == VK_FORMAT_R32_UINT || format == VK_FORMAT_R32G32B32A32_SFLOAT ||
               format == VK_FORMAT_R32G32B32A32_UINT);
   const size_t texelBytes = format == VK_FORMAT_R32_SFLOAT || format == VK_FORMAT_R32_UINT ? 4 : 16;
+  const size_t given = count;
   if (count == 0) count = 1;  // Vulkan forbids empty buffers; an empty array binds one texel
   if (count > ctx.limits().maxTexelBufferElements) {
     throw InputError(strf("%s: %s needs %zu elements, more than the device's texel buffer limit of %u (%s)",
@@ -123,7 +124,7 @@ TexelBuffer::TexelBuffer(Context& ctx, const void* data, size_t count, VkFormat 
                           kTooLargeHint));
   }
   buffer_ = Buffer(ctx, count * texelBytes, VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT, name);
-  if (data) buffer_.upload(data, count * texelBytes);
+  if (data && given > 0) buffer_.upload(data, given * texelBytes);
   VkBufferViewCreateInfo vi{VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO};
   vi.buffer = buffer_.handle();
   vi.format = format;

@@ -1,8 +1,8 @@
 // The scene's environment map for the GPU estimators (DESIGN §2; shaders/shared/envmap.h): the
 // texels (radiance times the light's `scale`) and the sampling CDFs built on the host, uploaded
 // as one texel buffer of 32-bit words (the GpuEnvMap header, then the data) bound at
-// BIND_ENV_MAP. A scene without a
-// map gets a one-texel black placeholder (its variants never read it).
+// BIND_ENV_MAP. A scene without a map gets a one-texel black placeholder (its variants never read
+// it).
 #pragma once
 
 #include "gpu/pipeline.h"

@@ -29,8 +29,9 @@ class GpuVolumeResources {
   // The descriptor types of the volume's bindings in a pass's table (the rest, the parameter
   // blocks among them, are storage buffers): the atlases sampled images, the indirections, the
   // majorants, the mean fields and the blackbody table uniform texel buffers (lanes read them at
-  // places of their own in the walks' loops: docs/architecture.md, "Descriptor kinds"). `restir`: with the mean field
-  // and the previous frame's volume (shaders/restir/bindings.glsl); `emission`: with the emission.
+  // places of their own in the walks' loops: docs/architecture.md, "Descriptor kinds").
+  // `restir`: with the mean field and the previous frame's volume (shaders/restir/bindings.glsl);
+  // `emission`: with the emission.
   static gpu::BindingTypes bindingTypes(bool restir, bool emission);
   // Binds ReSTIR's mean field (BIND_MEAN_FIELD): 512 words per atlas slot (slot index
   // x + X * (y + Y * z) of the packed slot coordinates), each voxel's mean and residual bound as
