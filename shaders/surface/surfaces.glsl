@@ -82,8 +82,10 @@ vec3 surf_normal(uint prim) {
 // interpolated normals where it has them, else the geometric normal.
 vec3 surf_shading_normal(uint prim, vec2 uv, vec3 geometric) {
   if (surf_triangle_texel(prim, 2u).w == 0u) return geometric;  // hasNormals
-  vec3 n = (1.0f - uv.x - uv.y) * uintBitsToFloat(surf_triangle_texel(prim, 3u).xyz) +
-           uv.x * uintBitsToFloat(surf_triangle_texel(prim, 4u).xyz) + uv.y * uintBitsToFloat(surf_triangle_texel(prim, 5u).xyz);
+  vec3 n0 = uintBitsToFloat(surf_triangle_texel(prim, 3u).xyz);
+  vec3 n1 = uintBitsToFloat(surf_triangle_texel(prim, 4u).xyz);
+  vec3 n2 = uintBitsToFloat(surf_triangle_texel(prim, 5u).xyz);
+  vec3 n = (1.0f - uv.x - uv.y) * n0 + uv.x * n1 + uv.y * n2;
   float len = length(n);
   return len > 0.0f ? n / len : geometric;
 }

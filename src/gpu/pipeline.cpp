@@ -94,8 +94,9 @@ DescriptorSet::~DescriptorSet() {
 }
 
 // One descriptor at `binding`, whose declared type must be one of `allowed` (one info is given).
-void DescriptorSet::write(uint32_t binding, std::initializer_list<BindingType> allowed, const VkDescriptorImageInfo* image,
-                          const VkDescriptorBufferInfo* buffer, const VkBufferView* texels) {
+void DescriptorSet::write(uint32_t binding, std::initializer_list<BindingType> allowed,
+                          const VkDescriptorImageInfo* image, const VkDescriptorBufferInfo* buffer,
+                          const VkBufferView* texels) {
   PLUME_CHECK(binding < pipeline_.bindings().size());
   const BindingType type = pipeline_.bindings()[binding];
   PLUME_CHECK(std::find(allowed.begin(), allowed.end(), type) != allowed.end());

@@ -113,8 +113,8 @@ void Buffer::fillZero() {
 // ---------------------------------------------------------------------------------------------
 TexelBuffer::TexelBuffer(Context& ctx, const void* data, size_t count, VkFormat format, const std::string& name)
     : ctx_(&ctx) {
-  PLUME_CHECK(format == VK_FORMAT_R32_SFLOAT || format == VK_FORMAT_R32_UINT || format == VK_FORMAT_R32G32B32A32_SFLOAT ||
-              format == VK_FORMAT_R32G32B32A32_UINT);
+  PLUME_CHECK(format == VK_FORMAT_R32_SFLOAT || format == VK_FORMAT_R32_UINT ||
+              format == VK_FORMAT_R32G32B32A32_SFLOAT || format == VK_FORMAT_R32G32B32A32_UINT);
   const size_t texelBytes = format == VK_FORMAT_R32_SFLOAT || format == VK_FORMAT_R32_UINT ? 4 : 16;
   const size_t given = count;
   if (count == 0) count = 1;  // Vulkan forbids empty buffers; an empty array binds one texel

@@ -157,7 +157,9 @@ GpuSurfaces::GpuSurfaces(gpu::Context& ctx, const Scene& scene) {
 
 gpu::BindingTypes GpuSurfaces::bindingTypes(uint32_t shift) {
   gpu::BindingTypes t;
-  for (uint32_t b = shared::BIND_BVH_NODES; b <= shared::BIND_EMITTERS; ++b) t.push_back({b + shift, gpu::BindingType::TexelBuffer});
+  for (uint32_t b = shared::BIND_BVH_NODES; b <= shared::BIND_EMITTERS; ++b) {
+    t.push_back({b + shift, gpu::BindingType::TexelBuffer});
+  }
   return t;
 }
 
