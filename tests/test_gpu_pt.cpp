@@ -95,6 +95,21 @@ TEST_F(GpuPathTracer, MultipleScatteringHighAlbedoMatchesReference) {
   renderAndCompare(ctx(), compiler(), s, test::makeNoiseGrid(40, 1.0 / 20, 5), 256, 512, "albedo099");
 }
 
+// render.density_filter = biased-hardware (the texture unit's trilinear filter): biased by the
+// device's rounding of the weights, which must stay below what this Z-test resolves (README "The
+// scene file"); a wrong filter coordinate (half a texel off, a wrong atlas size) fails it.
+TEST_F(GpuPathTracer, HardwareFilteredDensityMatchesReference) {
+  Scene s = baseScene({1.0f, 1.4f, 3.5f}, {1.0f, 1.0f, 1.0f}, 24);
+  s.media[0].densityScale = 60.0f;
+  s.media[0].albedo = glm::vec3(0.9f);
+  s.media[0].g = 0.6f;
+  s.render.maxBounces = 6;
+  s.render.densityFilter = "biased-hardware";
+  std::string variant;
+  renderAndCompare(ctx(), compiler(), s, test::makeNoiseGrid(40, 1.0 / 20, 3), 128, 256, "hwfilter", &variant);
+  EXPECT_NE(variant.find("hwfilter"), std::string::npos) << variant;
+}
+
 TEST_F(GpuPathTracer, CameraInsideTheMediumMatchesReference) {
   // The camera sits in the box's constant interior, looking across it. The point light in the
   // medium makes both estimators' variance infinite: next-event estimation weighs a vertex at

@@ -13,6 +13,8 @@
 
 #include <glm/glm.hpp>
 
+#include <cmath>
+
 using namespace plume;
 namespace sh = plume::shared;
 
@@ -90,6 +92,66 @@ TEST_F(GpuShared, GlslAndCppAgree) {
   EXPECT_EQ(rngMismatches, 0) << "RNG streams must be bit-exact";
   EXPECT_EQ(floatMismatches, 0);
   EXPECT_EQ(densityMismatches, 0) << "worst density difference " << worstDensity;
+}
+
+// render.density_filter = biased-hardware: the filtered lookup (texture() through the linear
+// sampler) against the exact trilinear field. Each of the 3 weights is rounded to the device's
+// sub-texel precision (VkPhysicalDeviceLimits::subTexelPrecisionBits), so the error is at most
+// 3 * 2^-bits of the spread of the 8 voxels (lavapipe filters floats with float weights: ~0).
+TEST_F(GpuShared, HardwareFilteredDensityIsWithinTheDeviceWeightPrecision) {
+  auto grid = test::makeNoiseGrid(40, 0.05);
+  LoadedGrid loaded;
+  loaded.grid = grid;
+  BakedVolume bake = bakeVolume(loaded);
+  GpuVolumeResources volume(ctx(), bake, 1.0f);
+  try {
+    volume.requireLinearFilter();
+  } catch (const InputError& e) {
+    GTEST_SKIP() << e.what();
+  }
+  const int n = 4096;
+  std::vector<KernelCase> cases(n);
+  sh::RngState setup = sh::rng_init(glm::uvec2(5, 6), 7, sh::RNG_STREAM_TEST, 11);
+  for (int i = 0; i < n; ++i) {
+    glm::vec3 p = glm::vec3(-2.0f) + 44.0f * glm::vec3(sh::rng_float(setup), sh::rng_float(setup), sh::rng_float(setup));
+    if (i % 4 == 0) p = glm::floor(p);  // voxel centres and brick borders
+    cases[i].point = glm::vec4(p, 0.0f);
+    cases[i].dir = glm::vec4(0.0f, 0.0f, 1.0f, 0.0f);
+  }
+  gpu::ComputePass pass(ctx(), compiler().compile("tests/shared_kernels.comp", {{"PLUME_HW_FILTER", "1"}}),
+                        gpu::bindingTable(7, GpuVolumeResources::bindingTypes(false, false)),
+                        4, "shared kernels (hardware filter)", glm::uvec3(64, 1, 1));
+  volume.bind(pass.set);
+  gpu::Buffer in(ctx(), n * sizeof(KernelCase), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "cases");
+  gpu::Buffer out(ctx(), n * sizeof(KernelResult), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "results");
+  in.upload(cases.data(), n * sizeof(KernelCase));
+  pass.set.bind(5, in);
+  pass.set.bind(6, out);
+  const uint32_t count = n;
+  ctx().submitAndWait([&](VkCommandBuffer cmd) { pass.record(cmd, glm::uvec3(n, 1, 1), &count); });
+  std::vector<KernelResult> gpuResults(n);
+  out.download(gpuResults.data(), n * sizeof(KernelResult));
+
+  const double weightStep = std::ldexp(1.0, -int(ctx().limits().subTexelPrecisionBits));
+  int outside = 0, nonZero = 0;
+  double worst = 0;
+  for (int i = 0; i < n; ++i) {
+    const glm::vec3 p = glm::vec3(cases[i].point);
+    const float exact = sampleDensity(bake, p);
+    float lo = exact, hi = exact;  // the 8 voxels' spread (a voxel's value is the field at its centre)
+    for (int c = 0; c < 8; ++c) {
+      const float v = sampleDensity(bake, glm::floor(p) + glm::vec3(c & 1, (c >> 1) & 1, (c >> 2) & 1));
+      lo = std::min(lo, v);
+      hi = std::max(hi, v);
+    }
+    const double err = std::abs(double(gpuResults[i].phase.z) - exact);
+    worst = std::max(worst, err);
+    outside += err > 3.0 * weightStep * (hi - lo) + 1e-6 * std::max(1.0f, exact);
+    nonZero += exact > 0.0f;
+  }
+  EXPECT_EQ(outside, 0) << "worst difference " << worst << " (subTexelPrecisionBits "
+                        << ctx().limits().subTexelPrecisionBits << ")";
+  EXPECT_GT(nonZero, n / 4) << "the cases must mostly fall where the grid has density";
 }
 
 // A texel buffer longer than the device allows is bad input (its size follows from the scene),

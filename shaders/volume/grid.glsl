@@ -1,5 +1,6 @@
 // The one lookup into a baked volume (DESIGN §3): trilinear density with exact weights
-// (8 texelFetch), per-brick majorants and ReSTIR's per-voxel mean field, for the current volume
+// (8 texelFetch; with PLUME_HW_FILTER, render.density_filter = biased-hardware, one texture()
+// through the texture unit's filter instead), per-brick majorants and ReSTIR's per-voxel mean field, for the current volume
 // or the previous frame's (temporal reuse), chosen by a parameter `v` (VOL_CURRENT,
 // VOL_PREVIOUS), never by a copy of the code. Mirrors media/bake_lookup.cpp texel for texel.
 // Requires volume/bindings.glsl.
@@ -65,14 +66,37 @@ float vol_corner_weight(int c, vec3 f) {
   return ((c & 1) != 0 ? f.x : 1.0f - f.x) * ((c & 2) != 0 ? f.y : 1.0f - f.y) * ((c & 4) != 0 ? f.z : 1.0f - f.z);
 }
 
+#ifdef PLUME_HW_FILTER
+// The texture unit's trilinear filter at atlas texel t + f (its sampler is linear: gpu::Image3D).
+// The weights are the device's (rounded to VkPhysicalDeviceLimits::subTexelPrecisionBits, 8 on
+// most GPUs; lavapipe filters float formats with float weights); still a convex combination of
+// the same 8 texels, so the brick majorants bound it. Biased against the exact field by at most
+// 3 * 2^-bits of the 8 texels' spread (tests/test_gpu_shared.cpp).
+vec3 vol_filter_coords(ivec3 t, vec3 f, ivec3 size) { return (vec3(t) + f + 0.5f) / vec3(size); }
+#ifdef PLUME_VOL_PREVIOUS
+float vol_filtered(uint v, ivec3 t, vec3 f) {
+  return v == VOL_CURRENT ? textureLod(volAtlas, vol_filter_coords(t, f, textureSize(volAtlas, 0)), 0.0f).r
+                          : textureLod(prevAtlas, vol_filter_coords(t, f, textureSize(prevAtlas, 0)), 0.0f).r;
+}
+#else
+float vol_filtered(uint v, ivec3 t, vec3 f) {
+  return textureLod(volAtlas, vol_filter_coords(t, f, textureSize(volAtlas, 0)), 0.0f).r;
+}
+#endif
+#endif
+
 // Density d at an index-space point (not yet multiplied by the density scale).
 float vol_density(uint v, vec3 p) {
   ivec3 t;
   vec3 f;
   if (!vol_locate(v, p, t, f)) return 0.0f;
+#ifdef PLUME_HW_FILTER
+  return vol_filtered(v, t, f);
+#else
   float sum = 0.0f;
   for (int c = 0; c < 8; ++c) sum += vol_corner_weight(c, f) * vol_texel(v, t + ivec3(c & 1, (c >> 1) & 1, (c >> 2) & 1));
   return sum;
+#endif
 }
 
 #ifdef PLUME_HAS_EMISSION
@@ -86,6 +110,19 @@ float vol_emission_texel(uint v, ivec3 t) {
 #else
 float vol_emission_texel(uint v, ivec3 t) { return texelFetch(volEmissionAtlas, t, 0).r; }
 #endif
+#ifdef PLUME_HW_FILTER
+#ifdef PLUME_VOL_PREVIOUS
+float vol_emission_filtered(uint v, ivec3 t, vec3 f) {
+  return v == VOL_CURRENT
+             ? textureLod(volEmissionAtlas, vol_filter_coords(t, f, textureSize(volEmissionAtlas, 0)), 0.0f).r
+             : textureLod(prevEmissionAtlas, vol_filter_coords(t, f, textureSize(prevEmissionAtlas, 0)), 0.0f).r;
+}
+#else
+float vol_emission_filtered(uint v, ivec3 t, vec3 f) {
+  return textureLod(volEmissionAtlas, vol_filter_coords(t, f, textureSize(volEmissionAtlas, 0)), 0.0f).r;
+}
+#endif
+#endif
 
 // The emitted radiance Le at an index-space point of volume v (DESIGN §2 "Emission"): the
 // emission grid e interpolated like the density, then the colour form emissionScale * e or the
@@ -95,8 +132,12 @@ vec3 vol_emitted_radiance(uint v, vec3 p) {
   ivec3 t;
   vec3 f;
   if (!vol_locate(v, p, t, f)) return vec3(0.0f);
+#ifdef PLUME_HW_FILTER
+  float e = vol_emission_filtered(v, t, f);
+#else
   float e = 0.0f;
   for (int c = 0; c < 8; ++c) e += vol_corner_weight(c, f) * vol_emission_texel(v, t + ivec3(c & 1, (c >> 1) & 1, (c >> 2) & 1));
+#endif
 #ifdef PLUME_EMISSION_BLACKBODY
   return VOL_PARAM(v, emissionScale) * bb_lookup(VOL_PARAM(v, temperatureScale) * (e - VOL_PARAM(v, temperatureOffset)));
 #else

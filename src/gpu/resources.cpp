@@ -188,8 +188,12 @@ Image3D::Image3D(Context& ctx, glm::ivec3 extent, VkFormat format, size_t texelB
   vi.format = format;
   vi.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
   PLUME_VK(vkCreateImageView(ctx.device(), &vi, nullptr, &view_));
+  VkFormatProperties fp{};
+  vkGetPhysicalDeviceFormatProperties(ctx.physicalDevice(), format, &fp);
+  linear_ = (fp.optimalTilingFeatures & VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT) != 0;
   VkSamplerCreateInfo si{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
-  si.magFilter = si.minFilter = VK_FILTER_NEAREST;
+  si.magFilter = si.minFilter = linear_ ? VK_FILTER_LINEAR : VK_FILTER_NEAREST;
+  si.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST;
   si.addressModeU = si.addressModeV = si.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
   PLUME_VK(vkCreateSampler(ctx.device(), &si, nullptr, &sampler_));
 }
@@ -200,6 +204,7 @@ Image3D& Image3D::operator=(Image3D&& o) noexcept {
   if (this != &o) {
     release();
     ctx_ = std::exchange(o.ctx_, nullptr);
+    linear_ = o.linear_;
     image_ = std::exchange(o.image_, VK_NULL_HANDLE);
     memory_ = std::exchange(o.memory_, VK_NULL_HANDLE);
     view_ = std::exchange(o.view_, VK_NULL_HANDLE);

@@ -71,7 +71,9 @@ class TexelBuffer {
   VkBufferView view_ = VK_NULL_HANDLE;
 };
 
-// A sampled 3D image (read with texelFetch) with a nearest sampler.
+// A sampled 3D image, read with texelFetch (exact, unfiltered) or, where the format allows
+// linear filtering, with texture() through the texture unit's trilinear filter: its sampler is
+// linear when the format can be filtered (texelFetch ignores the filter), nearest otherwise.
 class Image3D {
  public:
   Image3D() = default;
@@ -84,10 +86,12 @@ class Image3D {
   VkImageView view() const { return view_; }
   VkSampler sampler() const { return sampler_; }
   glm::ivec3 extent() const { return extent_; }
+  bool linearFilter() const { return linear_; }  // texture() filters (the format allows it)
 
  private:
   void release();
   Context* ctx_ = nullptr;
+  bool linear_ = false;
   VkImage image_ = VK_NULL_HANDLE;
   VkDeviceMemory memory_ = VK_NULL_HANDLE;
   VkImageView view_ = VK_NULL_HANDLE;

@@ -15,6 +15,7 @@ gpu::ShaderDefines FeatureSet::defines() const {
   if (blackbody) d.emplace_back("PLUME_EMISSION_BLACKBODY", "1");
   if (surfaces) d.emplace_back("PLUME_HAS_SURFACES", "1");
   if (emitters) d.emplace_back("PLUME_HAS_EMITTERS", "1");
+  if (hardwareFilter) d.emplace_back("PLUME_HW_FILTER", "1");
   if (kernelCounters) d.emplace_back("PLUME_KERNEL_COUNTERS", "1");
   return d;
 }
@@ -34,6 +35,7 @@ std::string FeatureSet::name() const {
   add(emission, blackbody ? "blackbody" : "emission");
   add(surfaces, "surfaces");
   add(emitters, "emitters");
+  add(hardwareFilter, "hwfilter");
   add(kernelCounters, "counters");
   return n.empty() ? "none" : n;
 }
@@ -51,6 +53,7 @@ FeatureSet featuresOf(const Scene& scene) {
     f.blackbody |= m.emission && m.emission->blackbody;
   }
   f.surfaces = !scene.surfaces.empty();
+  f.hardwareFilter = scene.render.densityFilter == "biased-hardware";
   f.emitters = std::any_of(scene.surfaces.begin(), scene.surfaces.end(), [](const Surface& s) { return s.emits(); });
   // With emission a path also gathers light along the segment after its last scattering, so one
   // bounce already needs the path loop.

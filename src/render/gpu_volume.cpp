@@ -137,6 +137,15 @@ void GpuVolumeResources::bind(gpu::DescriptorSet& set) const {
   }
 }
 
+void GpuVolumeResources::requireLinearFilter() const {
+  const bool ok = atlas_.linearFilter() && (!hasEmission_ || emissionAtlas_.linearFilter());
+  if (!ok) {
+    throw InputError(std::string("render.density_filter: biased-hardware: the device cannot filter the ") +
+                     (atlas_.linearFilter() ? "emission atlas (R32F)" : "brick atlas") +
+                     " linearly; use exact (the default)");
+  }
+}
+
 void GpuVolumeResources::bindMeanField(gpu::DescriptorSet& set) const { set.bind(shared::BIND_MEAN_FIELD, coarse_); }
 
 void GpuVolumeResources::bindAsPrevious(gpu::DescriptorSet& set) const {

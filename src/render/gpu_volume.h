@@ -40,6 +40,9 @@ class GpuVolumeResources {
   // Binds this volume as ReSTIR's previous-frame volume (BIND_PREV_*).
   void bindAsPrevious(gpu::DescriptorSet& set) const;
   const shared::GpuVolume& params() const { return params_; }
+  // For render.density_filter = biased-hardware (shaders read the atlases with texture()): throws
+  // InputError, naming the setting, where the device cannot filter the atlases' formats linearly.
+  void requireLinearFilter() const;
   // Changes the density scale in place (one small upload; the atlas and fields stay). The volume
   // then counts as a new one (serial). Not while a submitted pass still reads it.
   void setDensityScale(float densityScale);

@@ -92,6 +92,7 @@ PathTracer::Tracking& PathTracer::tracking(bool skipEmpty) {
 std::string PathTracer::variantName() const { return features_.name() + (skipEmpty_ ? "+skip" : ""); }
 
 void PathTracer::setVolume(const GpuVolumeResources& volume) {
+  if (features_.hardwareFilter) volume.requireLinearFilter();
   // Skipping pays when rays cross many bricks: a brick grid wider than 16 on some axis.
   const shared::GpuVolume& p = volume.params();
   const int widest = std::max(p.brickDims.x, std::max(p.brickDims.y, p.brickDims.z));

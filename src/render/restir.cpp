@@ -215,6 +215,7 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
 
 void Restir::setVolumes(const GpuVolumeResources& current, const GpuVolumeResources& previous) {
   PLUME_CHECK(current.hasMeanField() && previous.hasMeanField());  // baked with BakeOptions::meanField
+  if (features_.hardwareFilter) current.requireLinearFilter();
   for (gpu::ComputePass* p : passes()) {
     current.bind(p->set);
     current.bindMeanField(p->set);

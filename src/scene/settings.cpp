@@ -21,6 +21,11 @@ const std::vector<SettingDesc>& renderSettingsTable() {
        &RenderSettings::seed, 0, 4294967295.0, {}},
       {"rr_start_bounce", "first bounce at which Russian roulette may end a path",
        &RenderSettings::rrStartBounce, 1, 100000, {}},
+      {"density_filter",
+       "GPU density and emission lookups: exact (8 texel reads, the CPU reference's field) or biased-hardware "
+       "(the texture unit's trilinear filter: faster, biased by the device's rounding of the weights, "
+       "8 bits on most GPUs; README \"The scene file\")",
+       &RenderSettings::densityFilter, 0, 0, {"exact", "biased-hardware"}},
       {"restir_candidates", "ReSTIR: candidate paths M per pixel and frame", &RenderSettings::restirCandidates, 1, 64, {}},
       {"restir_neighbours", "ReSTIR: spatial neighbours k per round", &RenderSettings::restirNeighbours, 1, 8, {}},
       {"restir_radius", "ReSTIR: spatial neighbour radius in pixels", &RenderSettings::restirRadius, 1, 256, {}},

@@ -20,6 +20,10 @@ struct RenderSettings {
   int frameFirst = 1;        // render.frames = [first, last]
   int frameLast = 1;
   int rrStartBounce = 3;     // Russian roulette from this bounce on (unbiased)
+  // How the GPU estimators interpolate the density and emission grids: "exact" (8 texel reads,
+  // exact weights: the field the CPU reference tracks) or "biased-hardware" (the texture unit's
+  // trilinear filter: fewer instructions, weights rounded to the device's sub-texel precision).
+  std::string densityFilter = "exact";
   // Volumetric ReSTIR (DESIGN §4.2; src/render/restir.h)
   int restirCandidates = 4;          // M: candidate paths per pixel and frame
   int restirNeighbours = 3;          // k: spatial neighbours per round
