@@ -33,6 +33,15 @@ Scene baseScene(glm::vec3 position, glm::vec3 lookAt, int size) {
   return s;
 }
 
+Scene denseCloudScene() {
+  Scene s = baseScene({1.0f, 1.4f, 3.5f}, {1.0f, 1.0f, 1.0f}, 24);
+  s.media[0].densityScale = 60.0f;
+  s.media[0].albedo = glm::vec3(0.9f);
+  s.media[0].g = 0.6f;
+  s.render.maxBounces = 6;
+  return s;
+}
+
 Image renderReference(Scene s, openvdb::FloatGrid::Ptr grid, int spp) {
   s.render.spp = spp;
   s.render.seed = 12345;
@@ -78,11 +87,7 @@ TEST_F(GpuPathTracer, ThinSmokeMatchesReference) {
 }
 
 TEST_F(GpuPathTracer, DenseCloudMatchesReference) {
-  Scene s = baseScene({1.0f, 1.4f, 3.5f}, {1.0f, 1.0f, 1.0f}, 24);
-  s.media[0].densityScale = 60.0f;
-  s.media[0].albedo = glm::vec3(0.9f);
-  s.media[0].g = 0.6f;
-  s.render.maxBounces = 6;
+  Scene s = denseCloudScene();
   renderAndCompare(ctx(), compiler(), s, test::makeNoiseGrid(40, 1.0 / 20, 3), 128, 256, "dense");
 }
 
@@ -99,11 +104,7 @@ TEST_F(GpuPathTracer, MultipleScatteringHighAlbedoMatchesReference) {
 // device's rounding of the weights, which must stay below what this Z-test resolves (README "The
 // scene file"); a wrong filter coordinate (half a texel off, a wrong atlas size) fails it.
 TEST_F(GpuPathTracer, HardwareFilteredDensityMatchesReference) {
-  Scene s = baseScene({1.0f, 1.4f, 3.5f}, {1.0f, 1.0f, 1.0f}, 24);
-  s.media[0].densityScale = 60.0f;
-  s.media[0].albedo = glm::vec3(0.9f);
-  s.media[0].g = 0.6f;
-  s.render.maxBounces = 6;
+  Scene s = denseCloudScene();
   s.render.densityFilter = "biased-hardware";
   std::string variant;
   renderAndCompare(ctx(), compiler(), s, test::makeNoiseGrid(40, 1.0 / 20, 3), 128, 256, "hwfilter", &variant);

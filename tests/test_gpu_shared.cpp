@@ -30,7 +30,28 @@ struct KernelResult {
   glm::vec4 phase, hgDir, coneDir;
 };
 
-class GpuShared : public test::GpuTest {};
+class GpuShared : public test::GpuTest {
+ protected:
+  // Runs shaders/tests/shared_kernels.comp (compiled with `defines`) over `cases` on `volume`.
+  std::vector<KernelResult> runKernels(const GpuVolumeResources& volume, const std::vector<KernelCase>& cases,
+                                       const gpu::ShaderDefines& defines = {}) {
+    const size_t n = cases.size();
+    gpu::ComputePass pass(ctx(), compiler().compile("tests/shared_kernels.comp", defines),
+                          gpu::bindingTable(7, GpuVolumeResources::bindingTypes(false, false)),
+                          4, "shared kernels", glm::uvec3(64, 1, 1));
+    volume.bind(pass.set);
+    gpu::Buffer in(ctx(), n * sizeof(KernelCase), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "cases");
+    gpu::Buffer out(ctx(), n * sizeof(KernelResult), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "results");
+    in.upload(cases.data(), n * sizeof(KernelCase));
+    pass.set.bind(5, in);
+    pass.set.bind(6, out);
+    const uint32_t count = uint32_t(n);
+    ctx().submitAndWait([&](VkCommandBuffer cmd) { pass.record(cmd, glm::uvec3(count, 1, 1), &count); });
+    std::vector<KernelResult> results(n);
+    out.download(results.data(), n * sizeof(KernelResult));
+    return results;
+  }
+};
 
 }  // namespace
 
@@ -53,19 +74,7 @@ TEST_F(GpuShared, GlslAndCppAgree) {
     cases[i].dir = glm::vec4(wi, 2.0f * sh::rng_float(setup) - 1.0f);
     cases[i].seed = glm::uvec4(sh::rng_uint(setup) % 4096, sh::rng_uint(setup) % 4096, i, sh::rng_uint(setup));
   }
-  gpu::ComputePass pass(ctx(), compiler().compile("tests/shared_kernels.comp", {}),
-                        gpu::bindingTable(7, GpuVolumeResources::bindingTypes(false, false)),
-                        4, "shared kernels", glm::uvec3(64, 1, 1));
-  volume.bind(pass.set);
-  gpu::Buffer in(ctx(), n * sizeof(KernelCase), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "cases");
-  gpu::Buffer out(ctx(), n * sizeof(KernelResult), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "results");
-  in.upload(cases.data(), n * sizeof(KernelCase));
-  pass.set.bind(5, in);
-  pass.set.bind(6, out);
-  const uint32_t count = n;
-  ctx().submitAndWait([&](VkCommandBuffer cmd) { pass.record(cmd, glm::uvec3(n, 1, 1), &count); });
-  std::vector<KernelResult> gpuResults(n);
-  out.download(gpuResults.data(), n * sizeof(KernelResult));
+  const std::vector<KernelResult> gpuResults = runKernels(volume, cases);
 
   int rngMismatches = 0, floatMismatches = 0, densityMismatches = 0;
   double worstDensity = 0;
@@ -118,19 +127,7 @@ TEST_F(GpuShared, HardwareFilteredDensityIsWithinTheDeviceWeightPrecision) {
     cases[i].point = glm::vec4(p, 0.0f);
     cases[i].dir = glm::vec4(0.0f, 0.0f, 1.0f, 0.0f);
   }
-  gpu::ComputePass pass(ctx(), compiler().compile("tests/shared_kernels.comp", {{"PLUME_HW_FILTER", "1"}}),
-                        gpu::bindingTable(7, GpuVolumeResources::bindingTypes(false, false)),
-                        4, "shared kernels (hardware filter)", glm::uvec3(64, 1, 1));
-  volume.bind(pass.set);
-  gpu::Buffer in(ctx(), n * sizeof(KernelCase), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "cases");
-  gpu::Buffer out(ctx(), n * sizeof(KernelResult), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "results");
-  in.upload(cases.data(), n * sizeof(KernelCase));
-  pass.set.bind(5, in);
-  pass.set.bind(6, out);
-  const uint32_t count = n;
-  ctx().submitAndWait([&](VkCommandBuffer cmd) { pass.record(cmd, glm::uvec3(n, 1, 1), &count); });
-  std::vector<KernelResult> gpuResults(n);
-  out.download(gpuResults.data(), n * sizeof(KernelResult));
+  const std::vector<KernelResult> gpuResults = runKernels(volume, cases, {{"PLUME_HW_FILTER", "1"}});
 
   const double weightStep = std::ldexp(1.0, -int(ctx().limits().subTexelPrecisionBits));
   int outside = 0, nonZero = 0;

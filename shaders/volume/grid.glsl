@@ -72,16 +72,15 @@ float vol_corner_weight(int c, vec3 f) {
 // most GPUs; lavapipe filters float formats with float weights); still a convex combination of
 // the same 8 texels, so the brick majorants bound it. Biased against the exact field by at most
 // 3 * 2^-bits of the 8 texels' spread (tests/test_gpu_shared.cpp).
-vec3 vol_filter_coords(ivec3 t, vec3 f, ivec3 size) { return (vec3(t) + f + 0.5f) / vec3(size); }
+float vol_filter(sampler3D atlas, ivec3 t, vec3 f) {
+  return textureLod(atlas, (vec3(t) + f + 0.5f) / vec3(textureSize(atlas, 0)), 0.0f).r;
+}
 #ifdef PLUME_VOL_PREVIOUS
 float vol_filtered(uint v, ivec3 t, vec3 f) {
-  return v == VOL_CURRENT ? textureLod(volAtlas, vol_filter_coords(t, f, textureSize(volAtlas, 0)), 0.0f).r
-                          : textureLod(prevAtlas, vol_filter_coords(t, f, textureSize(prevAtlas, 0)), 0.0f).r;
+  return v == VOL_CURRENT ? vol_filter(volAtlas, t, f) : vol_filter(prevAtlas, t, f);
 }
 #else
-float vol_filtered(uint v, ivec3 t, vec3 f) {
-  return textureLod(volAtlas, vol_filter_coords(t, f, textureSize(volAtlas, 0)), 0.0f).r;
-}
+float vol_filtered(uint v, ivec3 t, vec3 f) { return vol_filter(volAtlas, t, f); }
 #endif
 #endif
 
@@ -113,14 +112,10 @@ float vol_emission_texel(uint v, ivec3 t) { return texelFetch(volEmissionAtlas, 
 #ifdef PLUME_HW_FILTER
 #ifdef PLUME_VOL_PREVIOUS
 float vol_emission_filtered(uint v, ivec3 t, vec3 f) {
-  return v == VOL_CURRENT
-             ? textureLod(volEmissionAtlas, vol_filter_coords(t, f, textureSize(volEmissionAtlas, 0)), 0.0f).r
-             : textureLod(prevEmissionAtlas, vol_filter_coords(t, f, textureSize(prevEmissionAtlas, 0)), 0.0f).r;
+  return v == VOL_CURRENT ? vol_filter(volEmissionAtlas, t, f) : vol_filter(prevEmissionAtlas, t, f);
 }
 #else
-float vol_emission_filtered(uint v, ivec3 t, vec3 f) {
-  return textureLod(volEmissionAtlas, vol_filter_coords(t, f, textureSize(volEmissionAtlas, 0)), 0.0f).r;
-}
+float vol_emission_filtered(uint v, ivec3 t, vec3 f) { return vol_filter(volEmissionAtlas, t, f); }
 #endif
 #endif
 
