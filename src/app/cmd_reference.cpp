@@ -19,11 +19,13 @@ namespace {
 using ReferenceArgs = FrameJobArgs;
 
 // The frame's render key (app/frame_output.h): the scene's part without the settings the reference
-// ignores (render.mode, the ReSTIR ones), and "mode=reference", so that --resume over frames of
+// ignores (render.mode, render.density_filter, the ReSTIR ones), and "mode=reference", so that --resume over frames of
 // `plume render` renders them again. Per-pixel random streams: no batch or thread count in it.
 RenderKey referenceRenderKey(const Scene& scene, int frame) {
   RenderKey key = sceneRenderKey(scene, frame,
-                                 [](const std::string& k) { return k != "mode" && k.rfind("restir_", 0) != 0; });
+                                 [](const std::string& k) {
+                                   return k != "mode" && k != "density_filter" && k.rfind("restir_", 0) != 0;
+                                 });
   key.add("mode", "reference");
   return key;
 }

@@ -69,12 +69,12 @@ void makeFolder(const fs::path& dir) {
 
 // What the reference's pixels depend on besides its file name's fields: the path tracer's render
 // key of the frame whose grid is held still (scene/render_key.h: camera, media, lights, every
-// render setting the path tracer reads; not mode, spp, seed or the ReSTIR settings), and the
-// grid file's size and time. An edited scene or a re-baked grid gets a new reference, never a
+// render setting the path tracer reads; not mode, spp, seed, density_filter (it is always exact)
+// or the ReSTIR settings), and the grid file's size and time. An edited scene or a re-baked grid gets a new reference, never a
 // stale one; tuning ReSTIR in the scene file keeps the cached one.
 uint64_t referenceKey(const Scene& s, int gridFrame) {
   const RenderKey render = sceneRenderKey(s, gridFrame, [](const std::string& k) {
-    return k != "mode" && k != "spp" && k != "seed" && k.rfind("restir_", 0) != 0;
+    return k != "mode" && k != "spp" && k != "seed" && k != "density_filter" && k.rfind("restir_", 0) != 0;
   });
   std::error_code ec;
   const fs::path vdb = s.medium().vdbPath(gridFrame);
@@ -103,6 +103,7 @@ Image loadOrBuildReference(gpu::Context& ctx, gpu::ShaderCompiler& compiler, con
   logInfo(strf("bench: building the reference %s (%d spp)", path.c_str(), refSpp));
   Scene rs = s;
   rs.render.seed = kConvergedSeed;
+  rs.render.densityFilter = "exact";  // the exact field, so a biased option's bias shows in the bench
   std::unique_ptr<Estimator> pt = makeEstimator(EstimatorKind::PathTracer, ctx, compiler, rs, {.batch = 32});
   pt->setVolumes(volume, nullptr);
   pt->renderFrame(frame, refSpp, {});
