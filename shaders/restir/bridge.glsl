@@ -290,6 +290,23 @@ void rs_copy_path(uint srcSet, uint srcPixel, uint dstSet, uint dstPixel) {
   for (uint i = 1u; i < head.w; ++i) rsBounces[b + i - 1u] = rsBounces[a + i - 1u];
 }
 
+// --- The reconnection shift ----------------------------------------------------------------------
+// The vertex the reconnection shift stores by its place (shared/restir_types.h): the first surface
+// vertex from the second on (kinds: RsPathHead.kinds, bit i - 1 for vertex i), 0 for none or
+// with the copy shift. A function of the stored path alone, so every domain agrees on it.
+uint rs_reconnect_vertex(uint kinds) {
+#ifdef PLUME_RS_RECONNECT
+  uint later = kinds & ~1u;
+  return later != 0u ? uint(findLSB(later)) + 1u : 0u;
+#else
+  return 0u;
+#endif
+}
+
+// The solid angle to area factor of the reconnection vertex x_r on triangle prim, reached along
+// the unit direction w from a ray origin at distance d: |cos_r| / d².
+float rs_reconnect_area_factor(uint prim, vec3 w, float d) { return abs(dot(surf_normal(prim), w)) / (d * d); }
+
 // --- The path contribution f_D(y) ----------------------------------------------------------------
 // y is the path stored at (set, pixel); D any domain. Vertices x_1 = o + t1 d(u, v), x_i = o_{i-1} +
 // t_i w_i (o_i: x_i, pushed off a surface towards w_{i+1}); f = prod_i [T(o_{i-1}, x_i) v(x_i)] *
@@ -299,6 +316,8 @@ void rs_copy_path(uint srcSet, uint srcPixel, uint dstSet, uint dstPixel) {
 // shift fails (f = 0) where the copied path cannot exist in D: a medium vertex with zero density
 // (or outside the volume) or behind a surface, a surface vertex whose ray meets no surface. A
 // path ending in emission has sigma_a(x_n) Le(x_n) in place of sigma_s(x_n) and the light term.
+// With the reconnection shift vertex r = rs_reconnect_vertex is the stored point x_r instead:
+// o_{r-1} is connected to it (f = 0 where a surface lies between) and f carries its area factor.
 vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool unbiased, inout RngState rng) {
   RsPathHead h = rs_load_head(set, pixelIndex);
   uint n = h.vertexCount;
@@ -316,7 +335,30 @@ vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool unbiased, 
 #ifdef PLUME_HAS_EMISSION
   emits = h.light == RS_LIGHT_EMISSION;
 #endif
+  uint reconnect = rs_reconnect_vertex(h.kinds);
   for (uint i = 1u; i <= n; ++i) {
+#ifdef PLUME_RS_RECONNECT
+    if (i == reconnect) {
+      vec4 b = rsBounces[base + i - 2u];
+      uint prim = floatBitsToUint(b.z);
+      vec3 p = surf_triangle_point(prim, b.xy);
+      vec3 o = vtx_at_origin(vx, p - vx.x);
+      float d = length(p - o);
+      if (!(d > 0.0f)) return vec3(0.0f);
+      w = (p - o) / d;
+      f *= vtx_at_scatter(vx, w);
+      prev = vx;
+      if (surf_occluded(o, w, d - surf_offset_length(p))) return vec3(0.0f);
+      f *= rs_transmittance(D.v, o, w, d, unbiased, rng) * rs_reconnect_area_factor(prim, w, d);
+#ifdef PLUME_HAS_EMITTERS
+      if (h.light == RS_LIGHT_EMITTER_HIT && i == n) return f * rs_emitter_hit(vtx_at_pdf(prev, w), prim, o, w, d);
+#endif
+      vec3 ng = surf_normal(prim);
+      x = p;
+      vx = vtx_surface(p, w, prim, surf_shading_normal(prim, b.xy, ng));
+      continue;
+    }
+#endif
     if (i >= 2u) {
       vec4 b = rsBounces[base + i - 2u];
 #ifdef PLUME_HAS_SURFACES

@@ -85,6 +85,7 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
     float t1 = 0.0f;
     uint keep = 0u;  // vertices of this walk's selected candidate (0: none): copied when the walk ends
     uint kinds = 0u;  // this walk's vertex kinds so far (RsPathHead.kinds)
+    vec4 slot = vec4(0.0f);  // vertex j's stored coordinates (j >= 2)
 #ifdef PLUME_HAS_SURFACES
     PathVertex prev = vtx_medium(x, w);  // the vertex that sampled w (the camera's, first)
 #endif
@@ -108,6 +109,16 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
         pdf *= trSurface;
         f *= trSurface;
         vx = vtx_surface(x, w, hit.prim, surf_shading_normal(hit.prim, vec2(hit.u, hit.v), surf_normal(hit.prim)));
+        slot = vec4(w, t);
+#ifdef PLUME_RS_RECONNECT
+        if (j >= 2u && rs_reconnect_vertex(kinds) == 0u) {
+          // The reconnection vertex (bridge.glsl): stored by its place, measured in area
+          float g = rs_reconnect_area_factor(hit.prim, w, t);
+          pdf *= g;
+          f *= g;
+          slot = vec4(hit.u, hit.v, uintBitsToFloat(hit.prim), t);
+        }
+#endif
         kinds |= 1u << (j - 1u);
 #ifdef PLUME_HAS_EMITTERS
         // The candidate ending with the emitter this direction hits (its direction-sampling
@@ -132,6 +143,7 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
       if (!(sigma > 0.0f) || !(sigmaC > 0.0f)) break;
       pdf *= sigmaC * exp(-tau);   // the sampling field's free-flight pdf
       vec3 fArrive = f * trTarget * sigma;  // before x_j scatters or absorbs
+      slot = vec4(w, t);
       f = fArrive * vtx_albedo(VERTEX_MEDIUM);
 #ifdef PLUME_HAS_SURFACES
       vx = vtx_medium(x, w);
@@ -153,7 +165,7 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
       if (j == 1u) {
         t1 = t;
       } else {
-        walk[j - 2u] = vec4(w, t);
+        walk[j - 2u] = slot;
       }
 #ifdef RS_ENDS_IN_EMISSION
       if (j > maxVertices) break;  // no scattering beyond max_bounces

@@ -19,6 +19,16 @@
 // "the first surface along w_i": its coordinate is the direction alone (t_i is stored but implied
 // by the domain's geometry), so the copy has Jacobian 1 there too, and the shift fails (f = 0)
 // where the copied ray's first event is of the other kind (notes/restir.md "Surfaces").
+// With the reconnection shift (render.restir_shift reconnect, PLUME_RS_RECONNECT) the first
+// surface vertex r >= 2 (rs_reconnect_vertex of the kinds) is stored by its place instead: its
+// slot holds (b1, b2, triangle, t), barycentrics of a point x_r on the triangle, and its
+// coordinate is x_r in area measure dA(x_r), so f and the source pdf both carry
+// |cos_r| / |x_r - o_{r-1}|² there (the solid angle to area conversion). Every domain reconnects
+// its own vertex r - 1 to the same x_r (visibility and transmittance along the new segment), and
+// the vertices after it are copied from x_r, so the path from x_r on is the same point set. The
+// coordinates are still copied (Jacobian 1 in them); measured in the direction w_r, as the copy
+// shift does, the same map has the GRIS reconnection Jacobian
+// (|cos_r'| / |cos_r|) (|x_r - o_{r-1}|² / |x_r - o'_{r-1}|²).
 #ifndef PLUME_SHARED_RESTIR_TYPES_H
 #define PLUME_SHARED_RESTIR_TYPES_H
 
@@ -56,7 +66,8 @@ const uint RS_MIS_BIASED = 2u;    // restir-biased: m_i = M_i / sum M, no MIS (b
 
 
 // Stored path header (one per pixel and reservoir set); vertices 2..n live in a separate buffer
-// of vec4(direction, t), RestirParams.bounceStride (= max_bounces - 1) slots per pixel and set.
+// of vec4(direction, t) (the reconnection vertex: vec4(b1, b2, triangle, t)),
+// RestirParams.bounceStride (= max_bounces - 1) slots per pixel and set.
 struct RsPathHead {
   vec2 lightSample;  // the light sample's two floats (rs_encode_dir of a direction, or unused)
   float t1;          // distance of the first vertex along the camera ray

@@ -109,16 +109,17 @@ vec3 surf_offset_origin(vec3 p, vec3 n, vec3 w) {
 // Whether a surface lies on the ray within (0, tMax) (shadow rays).
 bool surf_occluded(vec3 o, vec3 d, float tMax) { return bvh_any(o, d, 0.0f, tMax); }
 
+// The point of triangle prim at barycentrics b = (b1, b2) of v1 and v2 (Embree's (u, v)).
+vec3 surf_triangle_point(uint prim, vec2 b) {
+  return (1.0f - b.x - b.y) * surf_vertex(prim, 0u) + b.x * surf_vertex(prim, 1u) + b.y * surf_vertex(prim, 2u);
+}
+
 #ifdef PLUME_HAS_EMITTERS
 // A uniform point of a triangle from u in [0,1)² (the square-root map, as the reference), as
 // barycentrics (b1, b2) of v1 and v2.
 vec2 surf_uniform_barycentrics(vec2 u) {
   float r = sqrt(u.x);
   return vec2(r * (1.0f - u.y), r * u.y);
-}
-
-vec3 surf_triangle_point(uint prim, vec2 b) {
-  return (1.0f - b.x - b.y) * surf_vertex(prim, 0u) + b.x * surf_vertex(prim, 1u) + b.y * surf_vertex(prim, 2u);
 }
 
 vec3 surf_emission(uint prim) { return surf_material_emission(surf_surface(prim)); }

@@ -124,6 +124,7 @@ RenderSettings withRestir(RenderSettings rs, const RestirOptions& v) {
   rs.restirHistoryCap = v.historyCap;
   rs.restirPrefix = v.prefix;
   rs.restirLightCandidates = v.lightCandidates;
+  rs.restirShift = v.reconnect ? "reconnect" : "copy";
   return rs;
 }
 
@@ -167,7 +168,7 @@ BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Sce
     auto add = [&](RestirOptions v) { variants.emplace_back(v.name(), v); };
     // The scene's settings with pairwise MIS and with the generalised balance heuristic; temporal
     // reuse alone; M 2 and 8; the built-in defaults' 16 px radius (the bundled smoke sets 2 px);
-    // restir-biased.
+    // with surfaces, the other shift (reconnection or copy); restir-biased.
     RestirOptions v = base;
     v.mis = shared::RS_MIS_PAIRWISE;
     add(v);
@@ -181,6 +182,10 @@ BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Sce
     }
     if (base.radius != RestirOptions{}.radius) {
       v = base, v.mis = shared::RS_MIS_PAIRWISE, v.radius = RestirOptions{}.radius;
+      add(v);
+    }
+    if (!scene.surfaces.empty()) {  // the other shift
+      v = base, v.mis = shared::RS_MIS_PAIRWISE, v.reconnect = !base.reconnect;
       add(v);
     }
     v = base, v.mis = shared::RS_MIS_BIASED;

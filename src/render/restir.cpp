@@ -16,7 +16,8 @@ std::string RestirOptions::name() const {
   // The prefix only when it is not the default, so the names of earlier benches still match.
   // The light candidates likewise.
   const std::string k = (prefix == RestirOptions{}.prefix ? "" : strf(" K%d", prefix)) +
-                        (lightCandidates == RestirOptions{}.lightCandidates ? "" : strf(" L%d", lightCandidates));
+                        (lightCandidates == RestirOptions{}.lightCandidates ? "" : strf(" L%d", lightCandidates)) +
+                        (reconnect ? "" : " copy");
   if (rounds == 0) return strf("restir %s M%d R0 c%d%s", kind, candidates, historyCap, k.c_str());
   return strf("restir %s M%d k%d r%d R%d c%d%s", kind, candidates, neighbours, radius, rounds, historyCap, k.c_str());
 }
@@ -31,6 +32,7 @@ RestirOptions restirOptionsOf(const RenderSettings& rs) {
   o.mis = rs.restirMis == "gbh" ? shared::RS_MIS_GBH : shared::RS_MIS_PAIRWISE;
   o.prefix = rs.restirPrefix;
   o.lightCandidates = rs.restirLightCandidates;
+  o.reconnect = rs.restirShift != "copy";
   return o;
 }
 
@@ -150,6 +152,8 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
     d.emplace_back("PLUME_RS_RESIDUAL_SCALE", "16.0f");
     d.emplace_back("PLUME_RS_MIS", std::to_string(options_.mis) + "u");
     d.emplace_back("PLUME_RS_LIGHT_CANDIDATES", std::to_string(lightCandidates));
+    // The reconnection shift only where there are surface vertices to reconnect to.
+    if (features_.surfaces && options_.reconnect) d.emplace_back("PLUME_RS_RECONNECT", "1");
     d.insert(d.end(), extra.begin(), extra.end());
     return std::make_unique<gpu::ComputePass>(ctx, compiler.compile(file, d), bindings,
                                               uint32_t(sizeof(shared::RsPush)), name + variant, glm::uvec3(8, 8, 1));

@@ -38,6 +38,8 @@ struct RestirOptions {
   int prefix = 16;           // K: vertices a reservoir's path holds (<= RS_MAX_VERTICES); the paths
                              // of more vertices are path traced in final shading (notes/restir.md)
   int lightCandidates = 2;   // L: light samples resampled at each candidate vertex (restir/bridge.glsl)
+  bool reconnect = true;     // the reconnection shift at the first surface vertex after the primary
+                             // (false: the copy shift; shared/restir_types.h)
   std::string name() const;  // e.g. "restir pairwise M4 k3 r16 R1 c20" (r: radius in px)
 };
 // From the scene's render settings (render.restir_mis; mode restir-biased's RS_MIS_BIASED is set

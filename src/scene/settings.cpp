@@ -38,6 +38,12 @@ const std::vector<SettingDesc>& renderSettingsTable() {
        "ReSTIR: light samples drawn at each candidate vertex and resampled by their unshadowed contribution "
        "before one shadow ray (1 = one light sample; used with emissive surfaces only)",
        &RenderSettings::restirLightCandidates, 1, 64, {}},
+      {"restir_shift",
+       "ReSTIR: how reuse moves a path into another pixel where it meets surfaces: reconnect (the first surface "
+       "vertex after the primary one is kept in place and the shifted path connects to it) or copy (every "
+       "direction is copied; each surface vertex is wherever the copied ray lands). Both unbiased; scenes "
+       "without surfaces are unaffected",
+       &RenderSettings::restirShift, 0, 0, {"reconnect", "copy"}},
       {"restir_prefix",
        "ReSTIR: scattering vertices a reservoir's path holds (1-16, shared::RS_MAX_VERTICES); paths with more "
        "(up to max_bounces) are path traced in final shading",

@@ -36,14 +36,16 @@ inline RestirOptions spatialReuse(uint32_t mis) {
 }
 
 // ReSTIR (pairwise and GBH, or only `misKinds`; `runs` independent runs each;
-// reservoirs holding paths of at most `prefix` vertices, the rest the tail's)
-// against one reference of refSpp.
+// reservoirs holding paths of at most `prefix` vertices, the rest the tail's;
+// the reconnection shift or, with reconnect false, the copy shift) against one
+// reference of refSpp.
 inline void expectRestirMatchesReference(
     gpu::Context &ctx, gpu::ShaderCompiler &compiler, const Scene &s,
     openvdb::FloatGrid::Ptr grid, int runs, int refSpp, const std::string &name,
     std::vector<uint32_t> misKinds = {shared::RS_MIS_PAIRWISE,
                                       shared::RS_MIS_GBH},
-    int prefix = RestirOptions{}.prefix) {
+    int prefix = RestirOptions{}.prefix,
+    bool reconnect = RestirOptions{}.reconnect) {
   const Image ref = restirCheckReference(s, grid, refSpp);
   ExtremeCase c;
   c.name = name;
@@ -51,9 +53,10 @@ inline void expectRestirMatchesReference(
   c.grid = grid;
   for (const uint32_t mis : misKinds) {
     const std::string label =
-        name + (mis == shared::RS_MIS_GBH ? "_gbh" : "_pairwise");
+        name + (mis == shared::RS_MIS_GBH ? "_gbh" : "_pairwise") + (reconnect ? "" : "_copy");
     RestirOptions options = spatialReuse(mis);
     options.prefix = prefix;
+    options.reconnect = reconnect;
     const EstimatorRun run = runRestirCase(ctx, compiler, c, runs, options);
     ReferenceCheckOptions check;
     check.imageMeanVariance = run.imageMeanVariance;

@@ -95,4 +95,27 @@ inline Scene emissiveQuadsScene(int size, int bounces, float lowQuadHeight = 0.0
   return s;
 }
 
+// A thin cloud over the ground between a white wall (x = 0.3, facing +x) and a glowing wall
+// (x = 1.7, emitting towards -x, the only light but a dim sky), and a black fin between them
+// (x = 1) as high as both, seen from above. The ground right of the fin sees the glowing wall
+// from a few centimetres to a metre away, so the paths ground -> glowing wall that reuse moves
+// between pixels reconnect to it over distances and cosines that differ by large factors (the
+// reconnection shift's Jacobian, shared/restir_types.h); the ground left of the fin sees none of
+// it, so reconnecting a path from the right into a pixel on the left must fail (visibility).
+inline Scene wallsAndFinScene(int size, int bounces) {
+  Scene s = smokeOverGroundScene(size, bounces);
+  s.camera.base.position = {1.0f, 3.4f, 3.0f};
+  s.camera.base.lookAt = {1.0f, 0.2f, 1.0f};
+  s.medium().densityScale = 0.5f;
+  s.lights = {skyLight({0.02f, 0.025f, 0.03f})};
+  Surface left = planeSurface({0.3f, 0.6f, 1.0f}, {1.0f, 0.0f, 0.0f}, {1.2f, 3.0f});
+  left.albedo = glm::vec3(0.9f);
+  Surface fin = planeSurface({1.0f, 0.6f, 1.0f}, {1.0f, 0.0f, 0.0f}, {1.2f, 3.0f});
+  fin.albedo = glm::vec3(0.0f);
+  s.surfaces.push_back(left);
+  s.surfaces.push_back(emitterSurface({1.7f, 0.6f, 1.0f}, {-1.0f, 0.0f, 0.0f}, {1.2f, 3.0f}, {2.0f, 1.8f, 1.5f}));
+  s.surfaces.push_back(fin);
+  return s;
+}
+
 }  // namespace plume::test
