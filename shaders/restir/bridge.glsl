@@ -337,43 +337,49 @@ vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool unbiased, 
 #endif
   uint reconnect = rs_reconnect_vertex(h.kinds);
   for (uint i = 1u; i <= n; ++i) {
-#ifdef PLUME_RS_RECONNECT
-    if (i == reconnect) {
-      vec4 b = rsBounces[base + i - 2u];
-      uint prim = floatBitsToUint(b.z);
-      vec3 p = surf_triangle_point(prim, b.xy);
-      vec3 o = vtx_at_origin(vx, p - vx.x);
-      float d = length(p - o);
-      if (!(d > 0.0f)) return vec3(0.0f);
-      w = (p - o) / d;
-      f *= vtx_at_scatter(vx, w);
-      prev = vx;
-      if (surf_occluded(o, w, d - surf_offset_length(p))) return vec3(0.0f);
-      f *= rs_transmittance(D.v, o, w, d, unbiased, rng) * rs_reconnect_area_factor(prim, w, d);
-#ifdef PLUME_HAS_EMITTERS
-      if (h.light == RS_LIGHT_EMITTER_HIT && i == n) return f * rs_emitter_hit(vtx_at_pdf(prev, w), prim, o, w, d);
-#endif
-      vec3 ng = surf_normal(prim);
-      x = p;
-      vx = vtx_surface(p, w, prim, surf_shading_normal(prim, b.xy, ng));
-      continue;
-    }
-#endif
+    // Vertex i = reconnect shares the others' one closest-hit traversal (lavapipe runs both sides
+    // of a divergent branch): towards the stored point, up to just short of it, where any hit
+    // is an occluder.
+    bool rc = i == reconnect;
+    float tHitMax = SURF_FAR;
+    vec4 b = vec4(0.0f);
     if (i >= 2u) {
-      vec4 b = rsBounces[base + i - 2u];
+      b = rsBounces[base + i - 2u];
+      vec3 dir = b.xyz;
+#ifdef PLUME_RS_RECONNECT
+      vec3 p = vec3(0.0f);
+      if (rc) {
+        p = surf_triangle_point(floatBitsToUint(b.z), b.xy);
+        dir = normalize(p - vtx_at_origin(vx, p - vx.x));
+      }
+#endif
 #ifdef PLUME_HAS_SURFACES
-      f *= vtx_at_scatter(vx, b.xyz);
-      x = vtx_at_origin(vx, b.xyz);
+      f *= vtx_at_scatter(vx, dir);
+      x = vtx_at_origin(vx, dir);
       prev = vx;
 #else
-      f *= vtx_scatter(VERTEX_MEDIUM, w, b.xyz);
+      f *= vtx_scatter(VERTEX_MEDIUM, w, dir);
 #endif
-      w = b.xyz;
+      w = dir;
       t = b.w;
+#ifdef PLUME_RS_RECONNECT
+      if (rc) {
+        t = length(p - x);
+        if (!(t > 0.0f)) return vec3(0.0f);
+        w = (p - x) / t;
+        tHitMax = t - surf_offset_length(p);
+      }
+#endif
     }
     uint kind = vtx_kind(h.kinds, i);
 #ifdef PLUME_HAS_SURFACES
-    BvhHit hit = bvh_closest(x, w, 0.0f, SURF_FAR);
+    BvhHit hit = bvh_closest(x, w, 0.0f, tHitMax);
+#ifdef PLUME_RS_RECONNECT
+    if (rc) {
+      if (hit.prim != BVH_NONE) return vec3(0.0f);  // occluded
+      hit = BvhHit(t, floatBitsToUint(b.z), b.x, b.y);
+    }
+#endif
     if (kind == VERTEX_SURFACE) {
       if (hit.prim == BVH_NONE) return vec3(0.0f);
       t = hit.t;
@@ -382,6 +388,9 @@ vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool unbiased, 
     }
 #endif
     float tr = rs_transmittance(D.v, x, w, t, unbiased, rng);
+#ifdef PLUME_RS_RECONNECT
+    if (rc) tr *= rs_reconnect_area_factor(hit.prim, w, t);
+#endif
     vec3 o = x;
     x += t * w;
 #ifdef PLUME_HAS_SURFACES
