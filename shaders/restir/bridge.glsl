@@ -303,9 +303,11 @@ uint rs_reconnect_vertex(uint kinds) {
 #endif
 }
 
+#ifdef PLUME_RS_RECONNECT
 // The solid angle to area factor of the reconnection vertex x_r on triangle prim, reached along
 // the unit direction w from a ray origin at distance d: |cos_r| / d².
 float rs_reconnect_area_factor(uint prim, vec3 w, float d) { return abs(dot(surf_normal(prim), w)) / (d * d); }
+#endif
 
 // --- The path contribution f_D(y) ----------------------------------------------------------------
 // y is the path stored at (set, pixel); D any domain. Vertices x_1 = o + t1 d(u, v), x_i = o_{i-1} +
@@ -341,7 +343,9 @@ vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool unbiased, 
     // of a divergent branch): towards the stored point, up to just short of it, where any hit
     // is an occluder.
     bool rc = i == reconnect;
+#ifdef PLUME_HAS_SURFACES
     float tHitMax = SURF_FAR;
+#endif
     vec4 b = vec4(0.0f);
     if (i >= 2u) {
       b = rsBounces[base + i - 2u];
