@@ -304,6 +304,9 @@ TEST(RenderCli, ResumeRendersAFrameAgainWhenASettingItDependsOnChanged) {
       {dense, {"--width", "16", "--mode", "restir", "--restir-radius", "5"}, "restir_radius 2 -> 5"},
       {dense, {"--width", "16", "--mode", "restir", "--restir-radius", "5", "--max-bounces", "2"},
        "max_bounces 8 -> 2"},
+      // the shift changes nothing in a scene without surfaces
+      {dense, {"--width", "16", "--mode", "restir", "--restir-radius", "5", "--max-bounces", "2", "--restir-shift", "copy"},
+       "is complete, skipped"},
       {dense, {"--width", "16", "--max-bounces", "2"}, "mode restir -> pt"},
       {dense, {"--width", "12", "--max-bounces", "2"}, "camera.width 16 -> 12"},
       {thin, {"--width", "12", "--max-bounces", "2"}, "media[0].density_scale 16 -> 12"},

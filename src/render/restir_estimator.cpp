@@ -69,7 +69,10 @@ class RestirEstimator final : public Estimator {
   const PassTimes& lastPassTimes() const override { return restir_.lastPassTimes(); }
 
   RenderKey renderKey(int frame) const override {
-    return sceneRenderKey(scene_, frame, usesSetting);
+    // The shift changes nothing without surfaces (the same images): frames of such scenes
+    // rendered before the setting existed stay valid for --resume.
+    const bool surfaces = !scene_.surfaces.empty();
+    return sceneRenderKey(scene_, frame, [surfaces](const std::string& k) { return surfaces || k != "restir_shift"; });
   }
   void describe(std::map<std::string, std::string>& meta) const override {
     meta["variant"] = restir_.features().name();
