@@ -66,16 +66,36 @@ TEST_F(GpuRestirSurfaces, ReuseDoesNotLeakLightAcrossAnOccludersEdge) {
 // the ground on its other side. Without the visibility test of the reconnected segment the
 // per-pixel test fails (worst pixel z 5.4 left of the fin). Measuring the reconnection vertex in
 // solid angle instead of area (its cosine and squared-distance factor dropped in the candidates
-// and the target alike) is not resolved by this or any Z-test here (mean ratio 1.0020 either
-// way): with MIS weights of the balance form the error of a missing factor J is (1 - J)/(1 + J)
-// of the pair's share, which cancels between J and 1/J over neighbours drawn symmetrically
-// (notes/restir.md "The reconnection shift"). The factor in one place only fails at once (the
-// candidates without it: mean ratio 456).
+// and the target alike: the shift's Jacobian missing) is not resolved here (mean ratio 1.0020
+// either way): with MIS weights of the balance form the error of a missing factor J is
+// (1 - J)/(1 + J) of the pair's share, which cancels between J and 1/J over neighbours drawn
+// symmetrically (notes/restir.md "The reconnection shift"); the next test resolves it. The factor
+// in one place only fails at once (the candidates without it: mean ratio 456).
 TEST_F(GpuRestirSurfaces, ReconnectionBetweenWallsMatchesReference) {
   const Scene s = test::wallsAndFinScene(16, 3);
   const auto grid = test::makeNoiseGrid(32, 1.0 / 16, 11);
   for (bool reconnect : {true, false}) {
+    RestirOptions o = test::spatialReuse(shared::RS_MIS_PAIRWISE);
+    o.reconnect = reconnect;
     test::expectRestirMatchesReference(ctx(), compiler(), s, grid, 256, 4096, "walls_and_fin", {shared::RS_MIS_PAIRWISE},
-                                       RestirOptions{}.prefix, reconnect);
+                                       o);
   }
+}
+
+// The reconnection shift's Jacobian: every pixel reuses exactly one neighbour, the pixel four rows
+// up (RestirOptions::fixedNeighbourX/Y; unbiased, since the choice does not depend on the
+// samples), on a ground lit mostly by a wall's bounce (support/scenes.h sunlitWallScene), so that
+// the paths camera -> ground -> wall -> sun reconnect at the wall with J far from 1, always on the
+// same side. The offset is never mirrored, so a wrong Jacobian no longer cancels as it does
+// between the disk's symmetric neighbours. With the Jacobian dropped (rs_reconnect_area_factor
+// returning 1, in the candidates and the target alike) both kinds fail: pairwise mean ratio
+// 1.0114, aggregate z 4.9, worst pixel z 4.9; GBH 1.0201, z 8.2, worst pixel 8.6 (correct: 1.0019
+// and 1.0012, z <= 0.86, worst pixel 3.2). About 35 s.
+TEST_F(GpuRestirSurfaces, ReconnectionJacobianWithAFixedNeighbour) {
+  const Scene s = test::sunlitWallScene(16, 3);
+  const auto grid = test::makeNoiseGrid(32, 1.0 / 16, 11);
+  RestirOptions o = test::spatialReuse(shared::RS_MIS_PAIRWISE);
+  o.fixedNeighbourY = -4;  // four rows up: the neighbour's ground point is nearer the wall
+  test::expectRestirMatchesReference(ctx(), compiler(), s, grid, 512, 8192, "walls_fixed_neighbour",
+                                     {shared::RS_MIS_PAIRWISE, shared::RS_MIS_GBH}, o);
 }

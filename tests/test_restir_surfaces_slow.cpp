@@ -22,8 +22,10 @@ class GpuRestirSurfacesSlow : public test::GpuTest {};
 // -0.9); 1024 runs against 16384 spp pass (worst z -3.1, aggregate 0.9945, z
 // -1.75, resolving 1.1%). About 45 s.
 TEST_F(GpuRestirSurfacesSlow, TailPastAOneVertexPrefixMatchesReference) {
+  RestirOptions prefixOne = test::spatialReuse(shared::RS_MIS_PAIRWISE);
+  prefixOne.prefix = 1;
   test::expectRestirMatchesReference(
       ctx(), compiler(), test::emissiveQuadsScene(16, 3, 0.5f),
       test::makeNoiseGrid(32, 1.0 / 16, 7), 1024, 16384, "emissive_quads_tail",
-      {shared::RS_MIS_PAIRWISE}, 1);
+      {shared::RS_MIS_PAIRWISE}, prefixOne);
 }

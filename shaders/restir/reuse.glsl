@@ -103,7 +103,7 @@ bool rs_reproject(uvec2 pixel, out uvec2 prevPixel) {
 // One reuse step for `pixel` (index `index`): temporal (the canonical reservoir of set inSet and
 // the history of set histSet at the reprojected pixel, its confidence capped) or spatial
 // `spatialRound` (k neighbours of set inSet in the disk, drawn from the pixel and the round only, never
-// from the samples). Output: set outSet.
+// from the samples; or the one neighbour at the fixed offset of RestirParams, for tests). Output: set outSet.
 void rs_reuse_pixel(uvec2 pixel, uint index, bool temporal, uint spatialRound, uint inSet, uint histSet, uint outSet) {
   in_.count = 1u;
   in_.set = inSet;
@@ -130,6 +130,8 @@ void rs_reuse_pixel(uvec2 pixel, uint index, bool temporal, uint spatialRound, u
       vec2 u = rng_float2(rng);  // neighbour offsets: uniform in the disk, independent of samples
       float radius = rsp.radius * sqrt(u.x);
       ivec2 q = ivec2(pixel) + ivec2(round(radius * vec2(cos(2.0f * PLUME_PI * u.y), sin(2.0f * PLUME_PI * u.y))));
+      ivec2 fixedOffset = ivec2(rsp.fixedNeighbourX, rsp.fixedNeighbourY);
+      if (fixedOffset != ivec2(0)) q = ivec2(pixel) + fixedOffset;  // tests: one neighbour, never symmetric
       if (any(lessThan(q, ivec2(0))) || q.x >= int(frame.size.x) || q.y >= int(frame.size.y)) continue;
       if (q == ivec2(pixel)) continue;
       uint qi = uint(q.y) * frame.size.x + uint(q.x);

@@ -99,6 +99,12 @@ struct RestirParams {
   // max_bounces); final shading path-traces the paths with more (PLUME_RS_TAIL)
   uint prefixVertices;
   uint walksPerDispatch;    // candidates per dispatch: RS_CANDIDATE_VERTICES / walk length, at least 1
+  // Spatial reuse with a fixed neighbour (RestirOptions::fixedNeighbour, tests only): when not
+  // (0, 0), each round's one neighbour is the pixel at this offset (neighbours is 1)
+  int fixedNeighbourX;
+  int fixedNeighbourY;
+  uint pad0;
+  uint pad1;
 };
 
 // Push constants: which reservoir sets a pass reads and writes.
@@ -161,7 +167,7 @@ PLUME_NS_END
 static_assert(sizeof(plume::shared::RsPathHead) == 32, "RsPathHead crosses the bus");
 static_assert(offsetof(plume::shared::RsPathHead, vertexCount) == 12, "RsPathHead layout");
 static_assert(offsetof(plume::shared::RestirParams, candidates) == 64, "RestirParams layout");
-static_assert(sizeof(plume::shared::RestirParams) == 64 + 3 * 16, "RestirParams layout");
+static_assert(sizeof(plume::shared::RestirParams) == 64 + 4 * 16, "RestirParams layout");
 static_assert(sizeof(plume::shared::RsPush) == 32, "RsPush layout");
 #endif
 

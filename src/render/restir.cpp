@@ -17,7 +17,8 @@ std::string RestirOptions::name() const {
   // The light candidates likewise.
   const std::string k = (prefix == RestirOptions{}.prefix ? "" : strf(" K%d", prefix)) +
                         (lightCandidates == RestirOptions{}.lightCandidates ? "" : strf(" L%d", lightCandidates)) +
-                        (reconnect ? "" : " copy");
+                        (reconnect ? "" : " copy") +
+                        (fixedNeighbourX || fixedNeighbourY ? strf(" at(%d,%d)", fixedNeighbourX, fixedNeighbourY) : "");
   if (rounds == 0) return strf("restir %s M%d R0 c%d%s", kind, candidates, historyCap, k.c_str());
   return strf("restir %s M%d k%d r%d R%d c%d%s", kind, candidates, neighbours, radius, rounds, historyCap, k.c_str());
 }
@@ -213,8 +214,11 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   params_.lightCount = uint32_t(scene.lights.size()) + (surfaces_ && surfaces_->emitterCount() > 0 ? 1u : 0u);
   params_.historyCap = float(options_.historyCap);
   params_.reprojectionDepth = 1.0f;
-  params_.neighbours = uint32_t(options_.neighbours);
+  const bool fixedNeighbour = options_.fixedNeighbourX != 0 || options_.fixedNeighbourY != 0;
+  params_.neighbours = fixedNeighbour ? 1u : uint32_t(options_.neighbours);
   params_.radius = float(options_.radius);
+  params_.fixedNeighbourX = options_.fixedNeighbourX;
+  params_.fixedNeighbourY = options_.fixedNeighbourY;
 }
 
 void Restir::setVolumes(const GpuVolumeResources& current, const GpuVolumeResources& previous) {

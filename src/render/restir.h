@@ -40,6 +40,13 @@ struct RestirOptions {
   int lightCandidates = 2;   // L: light samples resampled at each candidate vertex (restir/bridge.glsl)
   bool reconnect = true;     // the reconnection shift at the first surface vertex after the primary
                              // (false: the copy shift; shared/restir_types.h)
+  // Tests only (no scene setting): when not (0, 0), every spatial round reuses exactly one
+  // neighbour, the pixel at this offset, instead of k drawn in the disk. Unbiased (the choice does
+  // not depend on the samples), but the offset is never mirrored, so an error of the shift that is
+  // odd in its Jacobian does not cancel as it does between the disk's symmetric neighbours
+  // (tests/test_restir_surfaces.cpp, the Jacobian test).
+  int fixedNeighbourX = 0;
+  int fixedNeighbourY = 0;
   std::string name() const;  // e.g. "restir pairwise M4 k3 r16 R1 c20" (r: radius in px)
 };
 // From the scene's render settings (render.restir_mis; mode restir-biased's RS_MIS_BIASED is set

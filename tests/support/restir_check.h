@@ -35,17 +35,16 @@ inline RestirOptions spatialReuse(uint32_t mis) {
   return o;
 }
 
-// ReSTIR (pairwise and GBH, or only `misKinds`; `runs` independent runs each;
-// reservoirs holding paths of at most `prefix` vertices, the rest the tail's;
-// the reconnection shift or, with reconnect false, the copy shift) against one
-// reference of refSpp.
+// ReSTIR (pairwise and GBH, or only `misKinds`; `runs` independent runs each)
+// against one reference of refSpp, with `base` (one spatial round by default;
+// its prefix, shift and neighbour choice kept, its MIS kind replaced by each
+// of misKinds).
 inline void expectRestirMatchesReference(
     gpu::Context &ctx, gpu::ShaderCompiler &compiler, const Scene &s,
     openvdb::FloatGrid::Ptr grid, int runs, int refSpp, const std::string &name,
     std::vector<uint32_t> misKinds = {shared::RS_MIS_PAIRWISE,
                                       shared::RS_MIS_GBH},
-    int prefix = RestirOptions{}.prefix,
-    bool reconnect = RestirOptions{}.reconnect) {
+    const RestirOptions &base = spatialReuse(shared::RS_MIS_PAIRWISE)) {
   const Image ref = restirCheckReference(s, grid, refSpp);
   ExtremeCase c;
   c.name = name;
@@ -53,10 +52,9 @@ inline void expectRestirMatchesReference(
   c.grid = grid;
   for (const uint32_t mis : misKinds) {
     const std::string label =
-        name + (mis == shared::RS_MIS_GBH ? "_gbh" : "_pairwise") + (reconnect ? "" : "_copy");
-    RestirOptions options = spatialReuse(mis);
-    options.prefix = prefix;
-    options.reconnect = reconnect;
+        name + (mis == shared::RS_MIS_GBH ? "_gbh" : "_pairwise") + (base.reconnect ? "" : "_copy");
+    RestirOptions options = base;
+    options.mis = mis;
     const EstimatorRun run = runRestirCase(ctx, compiler, c, runs, options);
     ReferenceCheckOptions check;
     check.imageMeanVariance = run.imageMeanVariance;

@@ -118,4 +118,27 @@ inline Scene wallsAndFinScene(int size, int bounces) {
   return s;
 }
 
+// A thin cloud over a white ground in front of a white wall (1 x 0.6 at z = 0.2, facing +z) that a
+// horizontal sun lights head-on while it grazes the ground (cosine 0), seen from above and close:
+// the ground's light is mostly the wall's bounce, whose paths camera -> ground -> wall -> sun
+// reconnect at the wall (the reconnection shift's vertex 2) from a few centimetres to a metre
+// away, so the shift's Jacobian (shared/restir_types.h) differs by large factors between pixels a
+// few rows apart, and for a small wall in front always on the same side.
+inline Scene sunlitWallScene(int size, int bounces) {
+  Scene s = sceneWithCamera("sunlit-wall", {1.0f, 1.9f, 2.0f}, {1.0f, 0.0f, 0.75f}, size);
+  s.media.push_back(Medium{});
+  s.medium().densityScale = 0.1f;
+  s.medium().albedo = glm::vec3(0.9f);
+  s.medium().g = 0.3f;
+  s.lights = {sunLight({0.0f, 0.0f, 1.0f}, {3.0f, 2.8f, 2.5f}), skyLight({0.02f, 0.025f, 0.03f})};
+  Surface ground = planeSurface({1.0f, 0.0f, 1.0f}, {0, 1, 0}, {8.0f, 8.0f});
+  ground.albedo = glm::vec3(0.8f);
+  Surface wall = planeSurface({1.0f, 0.3f, 0.2f}, {0, 0, 1}, {1.0f, 0.6f});
+  wall.albedo = glm::vec3(0.9f);
+  s.surfaces.push_back(ground);
+  s.surfaces.push_back(wall);
+  s.render.maxBounces = bounces;
+  return s;
+}
+
 }  // namespace plume::test
