@@ -1,4 +1,5 @@
 #include "core/error.h"
+#include "render/estimator.h"
 #include "scene/scene.h"
 
 #include <gtest/gtest.h>
@@ -127,4 +128,25 @@ TEST(Scene, EnvironmentMapKeys) {
   json two = doc;
   two["lights"].push_back(doc["lights"][1]);
   EXPECT_NE(errorIn(two).find("lights: at most one environment light may have a map"), std::string::npos) << errorIn(two);
+}
+
+// What each estimator's render key holds and the viewer greys out: the path tracer none of the
+// restir_* settings; ReSTIR all of them, but the shift only where the scene has surfaces (without
+// them it changes nothing, so frames rendered before the setting existed stay valid).
+TEST(Scene, EstimatorsUseTheSettingsTheirPixelsDependOn) {
+  Scene bare;
+  Scene withSurfaces;
+  withSurfaces.surfaces.push_back(Surface{});
+  for (const Scene* s : {&bare, &withSurfaces}) {
+    const auto& pt = estimatorTraits(EstimatorKind::PathTracer).usesSetting;
+    EXPECT_TRUE(pt(*s, "max_bounces"));
+    EXPECT_FALSE(pt(*s, "restir_shift"));
+    EXPECT_FALSE(pt(*s, "restir_candidates"));
+    for (EstimatorKind k : {EstimatorKind::Restir, EstimatorKind::RestirBiased}) {
+      const auto& restir = estimatorTraits(k).usesSetting;
+      EXPECT_TRUE(restir(*s, "max_bounces"));
+      EXPECT_TRUE(restir(*s, "restir_candidates"));
+      EXPECT_EQ(restir(*s, "restir_shift"), s == &withSurfaces);
+    }
+  }
 }

@@ -35,9 +35,9 @@ struct EstimatorTraits {
   // Throws InputError naming the scene key for settings it cannot render (before the device
   // starts; what needs the device is checked when it is made). May be empty.
   std::function<void(const Scene&)> check;
-  // Whether its pixels depend on the render setting `key` (scene/settings.h): its render key
-  // holds those, and the viewer greys out the others.
-  std::function<bool(const std::string& key)> usesSetting;
+  // Whether its pixels of `scene` depend on the render setting `key` (scene/settings.h): its
+  // render key holds those, and the viewer greys out the others.
+  std::function<bool(const Scene& scene, const std::string& key)> usesSetting;
 };
 const EstimatorTraits& estimatorTraits(EstimatorKind kind);
 

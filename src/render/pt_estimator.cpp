@@ -9,7 +9,7 @@ namespace plume {
 namespace {
 
 // Everything but ReSTIR's settings.
-bool usesSetting(const std::string& key) { return key.rfind("restir_", 0) != 0; }
+bool usesSetting(const Scene&, const std::string& key) { return key.rfind("restir_", 0) != 0; }
 
 class PathTracerEstimator final : public Estimator {
  public:
@@ -39,7 +39,7 @@ class PathTracerEstimator final : public Estimator {
   const PassTimes& lastPassTimes() const override { return tracer_.lastPassTimes(); }
 
   RenderKey renderKey(int frame) const override {
-    RenderKey key = sceneRenderKey(scene_, frame, usesSetting);
+    RenderKey key = sceneRenderKey(scene_, frame, [this](const std::string& k) { return usesSetting(scene_, k); });
     key.add("batch", std::to_string(batch_));  // frames from before session 7 depend on it (docs/farm.md)
     return key;
   }

@@ -9,7 +9,9 @@
 namespace plume {
 namespace {
 
-bool usesSetting(const std::string&) { return true; }
+// Every setting, but the shift only with surfaces: without them it changes nothing (the same
+// images), so frames of such scenes rendered before the setting existed stay valid for --resume.
+bool usesSetting(const Scene& scene, const std::string& key) { return !scene.surfaces.empty() || key != "restir_shift"; }
 
 class RestirEstimator final : public Estimator {
  public:
@@ -69,10 +71,7 @@ class RestirEstimator final : public Estimator {
   const PassTimes& lastPassTimes() const override { return restir_.lastPassTimes(); }
 
   RenderKey renderKey(int frame) const override {
-    // The shift changes nothing without surfaces (the same images): frames of such scenes
-    // rendered before the setting existed stay valid for --resume.
-    const bool surfaces = !scene_.surfaces.empty();
-    return sceneRenderKey(scene_, frame, [surfaces](const std::string& k) { return surfaces || k != "restir_shift"; });
+    return sceneRenderKey(scene_, frame, [this](const std::string& k) { return usesSetting(scene_, k); });
   }
   void describe(std::map<std::string, std::string>& meta) const override {
     meta["variant"] = restir_.features().name();

@@ -25,7 +25,7 @@ struct ViewState {
 
 struct ViewStats {
   std::string device, renderer;
-  std::function<bool(const std::string&)> usesSetting;  // the renderer's (render/estimator.h)
+  std::function<bool(const std::string&)> usesSetting;  // the renderer's for the working scene (render/estimator.h)
   double fps = 0, frameMs = 0;
   PassTimes passes;             // renderer passes of the last batch, then "display"
   int samples = 0;

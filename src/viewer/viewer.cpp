@@ -197,7 +197,9 @@ void Viewer::makeRenderer() {
   const EstimatorKind kind = estimatorKind(s_.scene.render);
   renderer_ = makeEstimator(kind, *ctx_, *compiler_, s_.scene);
   stats_.renderer = renderer_->name();
-  stats_.usesSetting = estimatorTraits(kind).usesSetting;
+  stats_.usesSetting = [uses = estimatorTraits(kind).usesSetting, this](const std::string& key) {
+    return uses(s_.scene, key);
+  };
 }
 
 void Viewer::rebuildRenderer() {
