@@ -62,7 +62,6 @@ class TexelBuffer {
   TexelBuffer& operator=(TexelBuffer&& o) noexcept;
 
   VkBufferView view() const { return view_; }
-  const Buffer& buffer() const { return buffer_; }
 
  private:
   void release();

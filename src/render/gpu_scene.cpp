@@ -2,6 +2,9 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "render/gpu_surfaces.h"
+#include "render/gpu_volume.h"
+#include "shaders/shared/bindings.h"
 
 #include <glm/glm.hpp>
 
@@ -104,6 +107,17 @@ Image readAccumulation(const gpu::Buffer& accum, int width, int height) {
     image.setVariance(x, y, varMean);
   }
   return image;
+}
+
+gpu::BindingTypes sceneBindingTypes(bool restir, bool emission, bool surfaces, uint32_t surfaceShift) {
+  gpu::BindingTypes t = GpuVolumeResources::bindingTypes(restir, emission);
+  t.push_back({shared::BIND_LIGHTS, gpu::BindingType::TexelBuffer});
+  t.push_back({shared::BIND_ENV_MAP, gpu::BindingType::TexelBuffer});
+  if (surfaces) {
+    const gpu::BindingTypes s = GpuSurfaces::bindingTypes(surfaceShift);
+    t.insert(t.end(), s.begin(), s.end());
+  }
+  return t;
 }
 
 }  // namespace plume

@@ -3,6 +3,7 @@
 // scene.
 #pragma once
 
+#include "gpu/pipeline.h"
 #include "gpu/resources.h"
 #include "io/image.h"
 #include "scene/scene.h"
@@ -26,6 +27,12 @@ bool sameCamera(const shared::GpuCamera& a, const shared::GpuCamera& b);  // eve
 // GpuFrame of `frame`: camera, medium, image size, bounces and light count from the scene;
 // the random-stream seed and frame key from the caller.
 shared::GpuFrame gpuFrame(const Scene& scene, int frame, uint32_t seed, uint32_t frameKey);
+
+// The descriptor types of the kernels that walk the scene, every other binding being a storage
+// buffer: the volume's (GpuVolumeResources::bindingTypes: ReSTIR's mean fields with `restir`, the
+// emission atlas with `emission`), the lights and the environment map as texel buffers, and with
+// `surfaces` the surfaces' (GpuSurfaces::bindingTypes, their binding numbers past `surfaceShift`).
+gpu::BindingTypes sceneBindingTypes(bool restir, bool emission, bool surfaces, uint32_t surfaceShift);
 
 // A progressive accumulation buffer (per pixel: vec4(mean rgb, n), vec4(M2 rgb, 0), Welford's
 // update on the GPU) read back as the mean and the variance of the mean.

@@ -41,14 +41,7 @@ PathTracer::PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const S
 
 // The descriptor types of the kernels that walk the scene (the rest are storage buffers).
 gpu::BindingTypes PathTracer::volumeTypes() const {
-  gpu::BindingTypes t = GpuVolumeResources::bindingTypes(false, features_.emission);
-  t.push_back({shared::BIND_LIGHTS, gpu::BindingType::TexelBuffer});
-  t.push_back({shared::BIND_ENV_MAP, gpu::BindingType::TexelBuffer});
-  if (features_.surfaces) {
-    const gpu::BindingTypes s = GpuSurfaces::bindingTypes();
-    t.insert(t.end(), s.begin(), s.end());
-  }
-  return t;
+  return sceneBindingTypes(false, features_.emission, features_.surfaces, 0);
 }
 
 std::unique_ptr<gpu::ComputePass> PathTracer::makePass(const std::string& file, const gpu::ShaderDefines& defines,

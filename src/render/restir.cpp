@@ -131,13 +131,8 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   const uint32_t count = features_.surfaces ? shared::RS_SURFACE_BINDING_COUNT
                          : features_.emission ? shared::EMISSION_BINDING_COUNT
                                               : shared::RS_BINDING_COUNT;
-  gpu::BindingTypes types = GpuVolumeResources::bindingTypes(true, features_.emission);
-  types.push_back({shared::BIND_LIGHTS, BindingType::TexelBuffer});
-  types.push_back({shared::BIND_ENV_MAP, BindingType::TexelBuffer});
-  if (features_.surfaces) {
-    const gpu::BindingTypes s = GpuSurfaces::bindingTypes(shared::RS_SURF_BINDING_SHIFT);
-    types.insert(types.end(), s.begin(), s.end());
-  }
+  const gpu::BindingTypes types =
+      sceneBindingTypes(true, features_.emission, features_.surfaces, shared::RS_SURF_BINDING_SHIFT);
   const std::vector<BindingType> bindings = gpu::bindingTable(count, types);
   const gpu::ShaderDefines defines = features_.defines();
   const std::string variant = " [" + features_.name() + "]";
