@@ -128,6 +128,27 @@ TEST(BenchCli, WritesTableCsvAndPlotWithSaneNumbersAndCachesTheReference) {
   EXPECT_EQ(countRefs(sceneDir / "bench_cache"), 2 * refs);
 }
 
+// Without --warmup the bench renders as many frames before measuring as the largest history cap c of
+// the ReSTIR variants it runs (one iteration per frame adds M to a history capped at c * M: after c
+// frames it is full), at least 4; the table's header says how many.
+TEST(BenchCli, WarmUpDefaultsToTheFramesTheHistoryNeedsToFill) {
+  const fs::path dir = test::outputDir("bench_cli_warmup");
+  const fs::path sceneDir = dir / "scene";
+  fs::create_directories(sceneDir);
+  fs::copy_file(test::sourcePath("volumes/smoke/smoke.json"), sceneDir / "smoke.json", fs::copy_options::overwrite_existing);
+  fs::copy_file(test::sourcePath("volumes/smoke/smoke_0001.vdb"), sceneDir / "smoke_0001.vdb",
+                fs::copy_options::overwrite_existing);
+  for (const auto& [cap, warmup] : {std::pair{"9", "Warm-up 9 frames"}, std::pair{"2", "Warm-up 4 frames"}}) {
+    test::RunResult r = test::runPlume({"bench", (sceneDir / "smoke.json").string(), "-o", (dir / "out").string(),
+                                        "--width", "8", "--height", "8", "--ref-spp", "16", "--measure", "1",
+                                        "--pt-spp", "1", "--no-cpu-ref", "--camera", "static", "--only", "R0",
+                                        "--restir-history-cap", cap});
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    const std::string md = readText(dir / "out" / "smoke_bench.md");
+    EXPECT_NE(md.find(warmup), std::string::npos) << "c " << cap << ":\n" << md;
+  }
+}
+
 TEST(BenchCli, AnUnknownVariantIsABadInput) {
   test::RunResult r = test::runPlume({"bench", test::sourcePath("volumes/smoke/smoke.json"), "-o",
                                       test::outputDir("bench_cli_bad"), "--width", "8", "--height", "8", "--only",

@@ -157,7 +157,8 @@ double ptCurveAt(const std::vector<std::pair<double, double>>& pts, double ms) {
 
 }  // namespace
 
-BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene, const BenchOptions& o) {
+BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene, const BenchOptions& options) {
+  BenchOptions o = options;  // the warm-up is filled in below
   BenchResult result;
   result.device = ctx.deviceName();
   const std::string dir = o.outDir.empty() ? (fs::path(scene.dir) / "bench_out").string() : o.outDir;
@@ -197,6 +198,12 @@ BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Sce
     });
     if (variants.empty()) throw InputError("bench: no ReSTIR variant matches --only");
   }
+  // Warm-up: enough frames for every variant's history to reach its cap (BenchOptions::warmup).
+  if (o.warmup < 0) {
+    o.warmup = 4;
+    for (const auto& [name, v] : variants) o.warmup = std::max(o.warmup, v.historyCap);
+  }
+  result.warmup = o.warmup;
   // One frame's grid (the first of the scene's range unless chosen), held still: the bench measures
   // the estimators, not the animation. Frame numbers count from it.
   const int first = o.gridFrame >= 0 ? o.gridFrame : scene.render.frameFirst;

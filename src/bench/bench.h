@@ -19,7 +19,10 @@
 namespace plume {
 
 struct BenchOptions {
-  int warmup = 4;          // frames before measuring (temporal reuse reaches steady state)
+  // Frames before measuring, so that temporal reuse reaches steady state: -1 (the default) takes
+  // the largest history cap c of the ReSTIR variants run (one iteration per frame adds M to a
+  // history capped at c * M, so after c frames it is full), at least 4.
+  int warmup = -1;
   int frames = 6;          // measured frames
   int gridFrame = -1;      // the animation frame whose grid is held still (-1: the scene's first)
   int refSpp = 2048;       // converged reference (GPU path tracer), >= 16x anything judged
@@ -47,6 +50,7 @@ struct BenchRow {
 struct BenchResult {
   std::vector<BenchRow> rows;
   double referenceRelMse = 0;  // estimated from the reference's own variance (worst frame)
+  int warmup = 0;              // frames rendered before measuring (BenchOptions::warmup resolved)
   std::string device;
   std::string markdown, csvPath, svgPath, mdPath;
 };
