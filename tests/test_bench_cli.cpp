@@ -49,15 +49,20 @@ size_t countRefs(const fs::path& dir) {
   return n;
 }
 
+// The bundled smoke's scene and first grid in `sceneDir`, where the bench may write its cache.
+void copySmokeScene(const fs::path& sceneDir) {
+  fs::create_directories(sceneDir);
+  fs::copy_file(test::sourcePath("volumes/smoke/smoke.json"), sceneDir / "smoke.json", fs::copy_options::overwrite_existing);
+  fs::copy_file(test::sourcePath("volumes/smoke/smoke_0001.vdb"), sceneDir / "smoke_0001.vdb",
+                fs::copy_options::overwrite_existing);
+}
+
 }  // namespace
 
 TEST(BenchCli, WritesTableCsvAndPlotWithSaneNumbersAndCachesTheReference) {
   const fs::path dir = test::outputDir("bench_cli");
   const fs::path sceneDir = dir / "scene";
-  fs::create_directories(sceneDir);
-  fs::copy_file(test::sourcePath("volumes/smoke/smoke.json"), sceneDir / "smoke.json", fs::copy_options::overwrite_existing);
-  fs::copy_file(test::sourcePath("volumes/smoke/smoke_0001.vdb"), sceneDir / "smoke_0001.vdb",
-                fs::copy_options::overwrite_existing);
+  copySmokeScene(sceneDir);
   const std::vector<std::string> args = {"bench", (sceneDir / "smoke.json").string(), "-o", (dir / "out").string(),
                                          "--width", "24", "--height", "24", "--ref-spp", "256", "--warmup", "2",
                                          "--measure", "3", "--pt-spp", "1", "4", "--only", "pairwise M4 k3 r16", "R0",
@@ -134,10 +139,7 @@ TEST(BenchCli, WritesTableCsvAndPlotWithSaneNumbersAndCachesTheReference) {
 TEST(BenchCli, WarmUpDefaultsToTheFramesTheHistoryNeedsToFill) {
   const fs::path dir = test::outputDir("bench_cli_warmup");
   const fs::path sceneDir = dir / "scene";
-  fs::create_directories(sceneDir);
-  fs::copy_file(test::sourcePath("volumes/smoke/smoke.json"), sceneDir / "smoke.json", fs::copy_options::overwrite_existing);
-  fs::copy_file(test::sourcePath("volumes/smoke/smoke_0001.vdb"), sceneDir / "smoke_0001.vdb",
-                fs::copy_options::overwrite_existing);
+  copySmokeScene(sceneDir);
   for (const auto& [cap, warmup] : {std::pair{"9", "Warm-up 9 frames"}, std::pair{"2", "Warm-up 4 frames"}}) {
     test::RunResult r = test::runPlume({"bench", (sceneDir / "smoke.json").string(), "-o", (dir / "out").string(),
                                         "--width", "8", "--height", "8", "--ref-spp", "16", "--measure", "1",
