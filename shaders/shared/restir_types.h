@@ -99,7 +99,7 @@ struct RestirParams {
   // max_bounces); final shading path-traces the paths with more (PLUME_RS_TAIL)
   uint prefixVertices;
   uint walksPerDispatch;    // candidates per dispatch: RS_CANDIDATE_VERTICES / walk length, at least 1
-  // Spatial reuse with a fixed neighbour (RestirOptions::fixedNeighbour, tests only): when not
+  // Spatial reuse with a fixed neighbour (RestirOptions::fixedNeighbourX/Y, tests only): when not
   // (0, 0), each round's one neighbour is the pixel at this offset (neighbours is 1)
   int fixedNeighbourX;
   int fixedNeighbourY;
