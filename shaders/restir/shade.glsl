@@ -139,12 +139,16 @@ vec3 rs_shade(RsDomain D, uint pixelIndex, uint set, inout RngState rng) {
   // hits one (a surface blocks the environment); one-segment paths, which no candidate ends with.
 #ifdef PLUME_HAS_EMITTERS
   // A small lamp covers a few percent of a pixel, and one camera ray per frame finds it or not:
-  // in the city (notes/city.md) those pixels were a fifth of a frame's relMSE. RS_DIRECT_RAYS
-  // rays stratified over the pixel's quarters (each: one BVH hit; the transmittance only where
-  // it sees light) estimate the pixel's mean with a quarter of the variance or less.
-  const uint RS_DIRECT_RAYS = 4u;
+  // in the city (notes/city.md) those pixels were a fifth of a frame's relMSE with 4 rays and
+  // most of what was left once the history was full. RS_DIRECT_RAYS rays stratified over a
+  // RS_DIRECT_SIDE² grid of the pixel (each: one BVH hit; the transmittance only where it sees
+  // light) estimate the pixel's mean: 16 rather than 4 took the city's still-camera relMSE from
+  // 0.668 to 0.264 (temporal reuse only; notes/city.md "Session 13").
+  const uint RS_DIRECT_SIDE = 4u;
+  const uint RS_DIRECT_RAYS = RS_DIRECT_SIDE * RS_DIRECT_SIDE;
   for (uint i = 0u; i < RS_DIRECT_RAYS; ++i) {
-    vec3 dir = rs_domain_dir(D, 0.5f * (vec2(float(i & 1u), float(i >> 1u)) + rng_float2(rng)));
+    vec2 cell = vec2(float(i % RS_DIRECT_SIDE), float(i / RS_DIRECT_SIDE));
+    vec3 dir = rs_domain_dir(D, (cell + rng_float2(rng)) * (1.0f / float(RS_DIRECT_SIDE)));
     BvhHit hit = bvh_closest(D.origin, dir, 0.0f, SURF_FAR);
     float tEnd = hit.prim != BVH_NONE ? hit.t : DDA_INF;
     vec3 Le = hit.prim != BVH_NONE ? surf_emitted(hit.prim, surf_normal(hit.prim), dir) : light_escaped(dir);
