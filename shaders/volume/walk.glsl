@@ -54,12 +54,11 @@ struct VolWalk {
   vec3 o;
   vec3 d;
   // VOL_FIELD_MEAN's exact voxels: the residual bound above which a voxel is exact for this
-  // direction; the current brick's first voxel (index space) and first atlas texel; whether the
-  // last segment is exact, and its voxel's 8 corner texels.
+  // direction; the current brick's first voxel (index space) and first atlas texel; the last
+  // exact voxel and its first corner texel.
   float exactBound;
   ivec3 brickVoxel;
   ivec3 brickTexel;
-  bool exact;
   ivec3 voxel;
   ivec3 texel;
 };
@@ -76,7 +75,6 @@ bool vol_walk_start(uint field, uint v, vec3 o, vec3 d, float tMax, out VolWalk 
   w.exactBound = PLUME_VOL_EXACT_TAU * max(max(abs(d.x), abs(d.y)), abs(d.z));
   w.brickVoxel = ivec3(0);
   w.brickTexel = ivec3(0);
-  w.exact = false;
   w.voxel = ivec3(0);
   w.texel = ivec3(0);
   if (field == VOL_FIELD_MAJORANT) {
@@ -96,35 +94,24 @@ bool vol_walk_start(uint field, uint v, vec3 o, vec3 d, float tMax, out VolWalk 
                   VOL_PARAM(v, brickDims));
 }
 
-// The next segment [a, b) and the field's value there: VOL_FIELD_MAJORANT (sigma_t majorant, 0);
-// VOL_FIELD_MEAN (sigma_t of the voxel mean, sigma_t bound of the residual). Segments come in
-// order; the field is 0 between them.
-bool vol_walk_next(uint field, inout VolWalk w, out float a, out float b, out vec2 value) {
+// The next segment [a, b) of the majorant field and its value there (sigma_t majorant, 0).
+// Segments come in order; the field is 0 between them. (The mean field's walks have their own
+// nested loops: vol_track_mean_closed, vol_track_mean_residual.)
+bool vol_walk_next(inout VolWalk w, out float a, out float b, out vec2 value) {
   a = 0.0f;
   b = 0.0f;
   value = vec2(0.0f);
 #ifndef PLUME_SKIP_EMPTY
-  if (field == VOL_FIELD_MAJORANT) {
-    ivec3 cell;
-    bool more = dda_next(w.outer, a, b, cell);
-    value.x = more ? vol_brick_majorant(cell) : 0.0f;
-    return more;
-  }
-#endif
+  ivec3 cell;
+  bool more = dda_next(w.outer, a, b, cell);
+  value.x = more ? vol_brick_majorant(cell) : 0.0f;
+  return more;
+#else
   for (;;) {
     if (w.innerLive) {
       ivec3 sub;
       if (dda_next(w.inner, a, b, sub)) {
-        if (field == VOL_FIELD_MAJORANT) {
-          value.x = vol_brick_majorant(w.outerCell * vol.levels[1].bricksPerCell + sub);
-        } else {
-#if defined(PLUME_VOL_MEAN_FIELD) || defined(PLUME_VOL_PREVIOUS)
-          value = w.scale * vol_mean_field(w.v, w.base + uint((sub.z * VOL_BRICK + sub.y) * VOL_BRICK + sub.x));
-          w.exact = value.y > w.exactBound;
-          w.voxel = w.brickVoxel + sub;
-          w.texel = w.brickTexel + sub;
-#endif
-        }
+        value.x = vol_brick_majorant(w.outerCell * vol.levels[1].bricksPerCell + sub);
         return true;
       }
       w.innerLive = false;
@@ -133,26 +120,15 @@ bool vol_walk_next(uint field, inout VolWalk w, out float a, out float b, out ve
     float ob;
     ivec3 cell;
     if (!dda_next(w.outer, oa, ob, cell)) return false;
-    if (field == VOL_FIELD_MAJORANT) {
-      if (vol_level_max(1, cell) <= 0.0f) continue;
-      int n = vol.levels[1].bricksPerCell;
-      w.outerCell = cell;
-      ivec3 dims = min(ivec3(n), vol.levels[0].cells - cell * n);
-      w.innerLive = dda_init(w.inner, w.o, w.d, oa, ob, vec3((vol.brickOrigin + cell * n) * VOL_BRICK),
-                             float(VOL_BRICK), dims);
-    } else {
-#if defined(PLUME_VOL_MEAN_FIELD) || defined(PLUME_VOL_PREVIOUS)
-      ivec3 brick = VOL_PARAM(w.v, brickOrigin) + cell;
-      uint slot = vol_packed_slot(w.v, brick);
-      if (slot == 0u) continue;
-      w.base = vol_mean_field_base(w.v, slot);
-      w.brickVoxel = brick * VOL_BRICK;
-      w.brickTexel = vol_slot_coords(slot) * VOL_TEXELS + 1;  // as vol_locate
-      w.innerLive = dda_init(w.inner, w.o, w.d, oa, ob, vec3(brick * VOL_BRICK), 1.0f, ivec3(VOL_BRICK));
-#endif
-    }
+    if (vol_level_max(1, cell) <= 0.0f) continue;
+    int n = vol.levels[1].bricksPerCell;
+    w.outerCell = cell;
+    ivec3 dims = min(ivec3(n), vol.levels[0].cells - cell * n);
+    w.innerLive = dda_init(w.inner, w.o, w.d, oa, ob, vec3((vol.brickOrigin + cell * n) * VOL_BRICK),
+                           float(VOL_BRICK), dims);
   }
   return false;
+#endif
 }
 
 // --- Trackers ------------------------------------------------------------------------------------
@@ -358,18 +334,13 @@ void vol_track_event(uint tracker, inout VolTrack s, uint v, float scale, vec3 p
 #define VOL_KC_ARG
 #endif
 
-// The walk's loops, two forms of the same draws in the same order (bit-identical results). A SIMD
-// back end runs a loop's whole body on every iteration while any lane needs it
-// (../shared/docs/LAVAPIPE.md), so which code shares a loop matters:
-//  - by collision (the majorant field: delta and ratio tracking): the outer loop makes one
-//    tentative collision, one density lookup, per iteration; the inner loop takes the draws and
-//    cheap majorant segments up to it and holds no lookup. The lookup then runs once per
-//    collision of the subgroup instead of once per draw (path tracer extension 11 % faster);
-//  - by segment (the mean field: ReSTIR's trackers): the outer loop takes a segment, whose voxel
-//    DDA, exact voxels and closed forms are heavy, the inner loop its draws and their cheap
-//    events (in the first form ReSTIR's shading was 1.7x slower).
-// (Majorant fields only: no exact voxels here.)
-void vol_track_by_collision(uint tracker, uint field, uint v, inout VolTrack s, inout VolWalk w, float scale, vec3 o,
+// The walk's loops. A SIMD back end runs a loop's whole body on every iteration while any lane
+// needs it (../shared/docs/LAVAPIPE.md), so which code shares a loop matters. The majorant field
+// (delta and ratio tracking) is walked by collision: the outer loop makes one tentative
+// collision, one density lookup, per iteration; the inner loop takes the draws and cheap majorant
+// segments up to it and holds no lookup. The lookup then runs once per collision of the subgroup
+// instead of once per draw (path tracer extension 11 % faster). The mean field: below.
+void vol_track_by_collision(uint tracker, uint v, inout VolTrack s, inout VolWalk w, float scale, vec3 o,
                             vec3 d, inout uint steps, inout RngState rng VOL_KC_PARAM) {
   float a = 0.0f;
   float b = 0.0f;
@@ -397,8 +368,8 @@ void vol_track_by_collision(uint tracker, uint field, uint v, inout VolTrack s, 
         }
         inSegment = false;
       } else {
-        // A segment is entered only where the tracker still needs one (as by_segment does).
-        if (!vol_track_alive(tracker, s) || !vol_walk_next(field, w, a, b, value)) break;
+        // A segment is entered only where the tracker still needs one.
+        if (!vol_track_alive(tracker, s) || !vol_walk_next(w, a, b, value)) break;
 #ifdef PLUME_KERNEL_COUNTERS
         vol_kc_segment(kc);
 #endif
@@ -416,46 +387,162 @@ void vol_track_by_collision(uint tracker, uint field, uint v, inout VolTrack s, 
   }
 }
 
-void vol_track_by_segment(uint tracker, uint field, uint v, inout VolTrack s, inout VolWalk w, float scale, vec3 o,
-                          vec3 d, inout uint steps, inout RngState rng VOL_KC_PARAM) {
-  float a;
-  float b;
-  vec2 value;
-  while (vol_track_alive(tracker, s) && vol_walk_next(field, w, a, b, value)) {
-#ifdef PLUME_KERNEL_COUNTERS
-    vol_kc_segment(kc);
-#endif
-    float mu;
 #if defined(PLUME_VOL_MEAN_FIELD) || defined(PLUME_VOL_PREVIOUS)
-    if (field == VOL_FIELD_MEAN && w.exact) {
-      mu = vol_track_exact(tracker, s, w, scale, a, b);
-    } else
-#endif
-    {
-      mu = vol_track_segment(tracker, s, a, b, value);
-    }
-    if (!(mu > 0.0f)) continue;
-    float t = a;
+// The mean field's walks, in nested loops: the voxel loop holds only a mean-field read, the
+// tracker's closed form for the voxel and, for RESIDUAL, the draws of its tentative collisions;
+// it leaves for the rare work, which the outer loop does: a new brick (the indirection read and
+// the voxel DDA's set-up; empty bricks in their own tight loop), an exact voxel (8 texel reads,
+// Gauss-Legendre, Newton) and a tentative collision's density lookup. As one loop over segments
+// (vol_walk_next), every voxel paid for all three on lavapipe: ReSTIR's candidates ran 3.7x and
+// its spatial reuse 2.2x slower (notes/bench/kernels.md, "Session 14"). The same segments in the
+// same order, so the same results to the bit.
+
+// Steps w.outer to the next occupied brick and sets w.inner up over its voxels; false past the
+// last one.
+bool vol_mean_enter_brick(inout VolWalk w) {
+  for (;;) {
+    float oa;
+    float ob;
+    ivec3 cell;
+    uint slot = 0u;
+    bool more;
     for (;;) {
-      if (++steps > VOL_MAX_STEPS) {
-        s.stop = true;
+      more = dda_next(w.outer, oa, ob, cell);
+      if (!more) break;
+      slot = vol_packed_slot(w.v, VOL_PARAM(w.v, brickOrigin) + cell);
+      if (slot != 0u) break;
+    }
+    if (!more) return false;
+    ivec3 brick = VOL_PARAM(w.v, brickOrigin) + cell;
+    w.base = vol_mean_field_base(w.v, slot);
+    w.brickVoxel = brick * VOL_BRICK;
+    w.brickTexel = vol_slot_coords(slot) * VOL_TEXELS + 1;  // as vol_locate
+    if (dda_init(w.inner, w.o, w.d, oa, ob, vec3(brick * VOL_BRICK), 1.0f, ivec3(VOL_BRICK))) return true;
+  }
+  return false;
+}
+
+// The next voxel [a, b) of the current brick and its value (sigma_t of the mean, sigma_t bound of
+// the residual); `exact`: the voxel is exact for this direction (w.voxel, w.texel then locate it).
+bool vol_mean_next_voxel(inout VolWalk w, out float a, out float b, out vec2 value, out bool exact) {
+  ivec3 sub;
+  value = vec2(0.0f);
+  exact = false;
+  if (!dda_next(w.inner, a, b, sub)) return false;
+  value = w.scale * vol_mean_field(w.v, w.base + uint((sub.z * VOL_BRICK + sub.y) * VOL_BRICK + sub.x));
+  exact = value.y > w.exactBound;
+  if (exact) {
+    w.voxel = w.brickVoxel + sub;
+    w.texel = w.brickTexel + sub;
+  }
+  return true;
+}
+
+// The closed-form trackers (TAU, SAMPLE: no draws).
+void vol_track_mean_closed(uint tracker, inout VolTrack s, inout VolWalk w, float scale VOL_KC_PARAM) {
+  bool innerLive = false;
+  bool pending = false;  // an exact voxel [a, b) waits for the outer loop
+  float a = 0.0f;
+  float b = 0.0f;
+  for (;;) {
+    if (pending) {
+      pending = false;
+      vol_track_exact(tracker, s, w, scale, a, b);
+      if (!vol_track_alive(tracker, s)) break;
+    }
+    if (!innerLive) {
+      if (!vol_mean_enter_brick(w)) break;
+      innerLive = true;
+    }
+    for (;;) {
+      vec2 value;
+      if (!vol_mean_next_voxel(w, a, b, value, pending)) {
+        innerLive = false;
         break;
       }
 #ifdef PLUME_KERNEL_COUNTERS
-      vol_kc_step(kc);
+      vol_kc_segment(kc);
 #endif
-      uvec4 h = rng_next4(rng);
-      t -= log(1.0f - rng_to_float(h.x)) / mu;
-      if (!(t < b)) break;
+      if (pending) break;
+      vol_track_segment(tracker, s, a, b, value);
+      if (!vol_track_alive(tracker, s)) break;
+    }
+    if (!pending && !vol_track_alive(tracker, s)) break;
+  }
+}
+
+// Residual ratio tracking: the voxel loop also draws the tentative collisions and leaves at one.
+const uint VOL_PENDING_NONE = 0u;
+const uint VOL_PENDING_EXACT = 1u;  // an exact voxel over [a, b)
+const uint VOL_PENDING_EVENT = 2u;  // a tentative collision at t
+void vol_track_mean_residual(uint tracker, uint v, inout VolTrack s, inout VolWalk w, float scale, vec3 o, vec3 d,
+                             inout uint steps, inout RngState rng VOL_KC_PARAM) {
+  bool innerLive = false;
+  bool inSegment = false;  // drawing tentative collisions in [a, b) at rate mu
+  uint pending = VOL_PENDING_NONE;
+  float a = 0.0f;
+  float b = 0.0f;
+  vec2 value = vec2(0.0f);
+  float mu = 0.0f;
+  float t = 0.0f;
+  uvec4 h = uvec4(0u);
+  for (;;) {
+    if (pending == VOL_PENDING_EXACT) {
+      vol_track_exact(tracker, s, w, scale, a, b);
+    } else if (pending == VOL_PENDING_EVENT) {
 #ifdef PLUME_KERNEL_COUNTERS
       vol_kc_lookup(kc);
 #endif
       vol_track_event(tracker, s, v, scale, o + t * d, t, mu, value, rng_to_float(h.y), rng);
       if (s.stop) break;
     }
+    pending = VOL_PENDING_NONE;
+    if (!inSegment) {
+      if (!vol_track_alive(tracker, s)) break;
+      if (!innerLive) {
+        if (!vol_mean_enter_brick(w)) break;
+        innerLive = true;
+      }
+    }
+    for (;;) {
+      if (inSegment) {
+        if (++steps > VOL_MAX_STEPS) {
+          s.stop = true;
+          break;
+        }
+#ifdef PLUME_KERNEL_COUNTERS
+        vol_kc_step(kc);
+#endif
+        h = rng_next4(rng);
+        t -= log(1.0f - rng_to_float(h.x)) / mu;
+        if (t < b) {
+          pending = VOL_PENDING_EVENT;
+          break;
+        }
+        inSegment = false;
+      } else {
+        bool exact;
+        if (!vol_track_alive(tracker, s)) break;
+        if (!vol_mean_next_voxel(w, a, b, value, exact)) {
+          innerLive = false;
+          break;
+        }
+#ifdef PLUME_KERNEL_COUNTERS
+        vol_kc_segment(kc);
+#endif
+        if (exact) {
+          pending = VOL_PENDING_EXACT;
+          break;
+        }
+        mu = vol_track_segment(tracker, s, a, b, value);
+        t = a;
+        inSegment = mu > 0.0f;
+      }
+    }
+    if (s.stop) break;
   }
 }
-
+#endif
 // The walk. `init`: the tracker's starting value (RATIO, RESIDUAL 1; TAU 0; SAMPLE the optical
 // depth to the collision). Tentative collisions restart at each segment's entry (exponential
 // steps are memoryless); each step draws one rng_next4 (its x: the step, its y: the event's u).
@@ -481,9 +568,15 @@ VolTrack vol_track(uint tracker, uint v, vec3 xWorld, vec3 wWorld, float tMax, f
 #endif
   float scale = vol_scale(v);  // sigma_t = scale * d, read once per walk
   if (field == VOL_FIELD_MAJORANT) {
-    vol_track_by_collision(tracker, field, v, s, w, scale, o, d, steps, rng VOL_KC_ARG);
+    vol_track_by_collision(tracker, v, s, w, scale, o, d, steps, rng VOL_KC_ARG);
   } else {
-    vol_track_by_segment(tracker, field, v, s, w, scale, o, d, steps, rng VOL_KC_ARG);
+#if defined(PLUME_VOL_MEAN_FIELD) || defined(PLUME_VOL_PREVIOUS)
+    if (tracker == VOL_TRACK_RESIDUAL) {
+      vol_track_mean_residual(tracker, v, s, w, scale, o, d, steps, rng VOL_KC_ARG);
+    } else {
+      vol_track_mean_closed(tracker, s, w, scale VOL_KC_ARG);
+    }
+#endif
   }
   if (steps > VOL_MAX_STEPS) atomicAdd(volCounters[0], 1u);  // truncated: counted, never silent
 #ifdef PLUME_KERNEL_COUNTERS
