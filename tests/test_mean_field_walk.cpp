@@ -1,0 +1,247 @@
+// ReSTIR's mean-field walks (shaders/volume/walk.glsl vol_track_mean_closed) against an
+// independent CPU integration of the same field: the optical depth of vol_mean_tau, and the
+// collision of vol_mean_sample, which must sit where the field's optical depth from the origin
+// reaches -log(1 - u) and report the field's value there. The field: in each voxel the baked mean
+// (bake.h voxelMean), or, in an "exact" voxel (residual bound times the longest chord of the ray's
+// direction through a voxel above PLUME_VOL_EXACT_TAU = 0.5), the fine trilinear density itself.
+// The ReSTIR Z-tests cannot see a wrong optical depth of the target (p̂ may be any positive
+// function), so this test is what guards the walk's voxels, bricks and exact voxels.
+#include "gpu/pipeline.h"
+#include "media/vdb_loader.h"
+#include "render/gpu_volume.h"
+#include "shaders/shared/bindings.h"
+#include "support/gpu_fixture.h"
+#include "support/grids.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <vector>
+
+using namespace plume;
+
+namespace {
+
+constexpr float kExactTau = 0.5f;  // PLUME_VOL_EXACT_TAU's default (volume/walk.glsl)
+constexpr float kMaxTau = 80.0f;   // VOL_MAX_TAU: the depth walk stops once past it
+
+struct Ray {
+  glm::vec3 o;
+  glm::vec3 d;  // unit, world space
+  float tMax;
+  float u;
+};
+
+// The walk's field at index-space point p for a ray of index-space direction dI (sigma_t, world
+// units): the voxel mean, or the trilinear density in an exact voxel; `exact` says which.
+float fieldAt(const BakedVolume& vol, float scale, glm::vec3 p, glm::vec3 dI, bool* exact = nullptr) {
+  const glm::ivec3 v(glm::floor(p));
+  const uint32_t slot = brickSlot(vol, glm::ivec3(v.x >> 3, v.y >> 3, v.z >> 3));
+  if (exact) *exact = false;
+  if (slot == 0) return 0.0f;
+  const glm::ivec3 l = v - glm::ivec3(v.x >> 3, v.y >> 3, v.z >> 3) * 8;
+  const size_t i = size_t(slot) * 512 + size_t((l.z * 8 + l.y) * 8 + l.x);
+  const float bound = kExactTau * std::max({std::abs(dI.x), std::abs(dI.y), std::abs(dI.z)});
+  const bool isExact = scale * vol.voxelResidual[i] > bound;
+  if (exact) *exact = isExact;
+  return scale * (isExact ? sampleDensity(vol, p) : vol.voxelMean[i]);
+}
+
+// Optical depth over (0, t), exactly: the ray cut at every integer plane of index space it
+// crosses (all crossings of each axis, sorted), each piece at its voxel's mean times its length,
+// or in an exact voxel the trilinear density (a cubic along the piece) by 4-point Gauss-Legendre.
+double cpuTau(const BakedVolume& vol, float scale, const Ray& r, double t) {
+  const glm::dvec3 oI = glm::dvec3(vol.worldToIndex * glm::vec4(r.o, 1.0f));
+  const glm::dvec3 dI = glm::dvec3(glm::mat3(vol.worldToIndex) * r.d);
+  std::vector<double> cuts = {0.0, t};
+  for (int a = 0; a < 3; ++a) {
+    if (std::abs(dI[a]) < 1e-12) continue;
+    const double p0 = oI[a], p1 = oI[a] + t * dI[a];
+    for (double k = std::ceil(std::min(p0, p1)); k <= std::floor(std::max(p0, p1)); k += 1.0) {
+      const double tc = (k - oI[a]) / dI[a];
+      if (tc > 0.0 && tc < t) cuts.push_back(tc);
+    }
+  }
+  std::sort(cuts.begin(), cuts.end());
+  static const double x[4] = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563, 0.8611363115940526};
+  static const double w[4] = {0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.3478548451374538};
+  double tau = 0.0;
+  for (size_t k = 0; k + 1 < cuts.size(); ++k) {
+    const double a = cuts[k], b = cuts[k + 1];
+    if (!(b > a)) continue;
+    bool exact = false;
+    const float mid = fieldAt(vol, scale, glm::vec3(oI + 0.5 * (a + b) * dI), glm::vec3(dI), &exact);
+    if (!exact) {
+      tau += double(mid) * (b - a);
+      continue;
+    }
+    double sum = 0.0;
+    for (int g = 0; g < 4; ++g) {
+      const double tg = 0.5 * (a + b) + 0.5 * (b - a) * x[g];
+      // The voxel of the piece's midpoint (a Gauss point may round onto its face).
+      const glm::vec3 p = glm::clamp(glm::vec3(oI + tg * dI), glm::floor(glm::vec3(oI + 0.5 * (a + b) * dI)),
+                                     glm::floor(glm::vec3(oI + 0.5 * (a + b) * dI)) + 0.99999f);
+      sum += w[g] * double(scale) * double(sampleDensity(vol, p));
+    }
+    tau += 0.5 * (b - a) * sum;
+  }
+  return tau;
+}
+
+// Where the ray may meet the field: its (t0, t1) inside the world bounds (t1 <= t0: never).
+void clip(const BakedVolume& vol, const Ray& r, double& t0, double& t1) {
+  t0 = 0.0;
+  t1 = r.tMax;
+  for (int a = 0; a < 3; ++a) {
+    if (std::abs(r.d[a]) < 1e-12) continue;
+    double ta = (vol.worldBoundsMin[a] - r.o[a]) / r.d[a], tb = (vol.worldBoundsMax[a] - r.o[a]) / r.d[a];
+    t0 = std::max(t0, std::min(ta, tb));
+    t1 = std::min(t1, std::max(ta, tb));
+  }
+}
+
+class MeanFieldWalk : public test::GpuTest {
+ protected:
+  struct Result {
+    float tau, t, sigma, unused;
+  };
+
+  std::vector<Result> run(const BakedVolume& bake, float scale, const std::vector<Ray>& rays) {
+    GpuVolumeResources volume(ctx(), bake, scale);
+    using gpu::BindingType;
+    const uint32_t rayBinding = shared::BIND_MEAN_FIELD + 1, resultBinding = shared::BIND_MEAN_FIELD + 2;
+    gpu::ComputePass pass(ctx(), compiler().compile("tests/mean_field_kernel.comp", {}),
+                          gpu::bindingTable(resultBinding + 1, {{shared::BIND_ATLAS, BindingType::SampledImage},
+                                                                {shared::BIND_INDIRECTION, BindingType::TexelBuffer},
+                                                                {shared::BIND_MAJORANTS, BindingType::TexelBuffer},
+                                                                {shared::BIND_MEAN_FIELD, BindingType::TexelBuffer}}),
+                          4, "mean field walk", glm::uvec3(64, 1, 1));
+    volume.bind(pass.set);
+    volume.bindMeanField(pass.set);
+    std::vector<glm::vec4> words;
+    for (const Ray& r : rays) {
+      words.push_back(glm::vec4(r.o, r.tMax));
+      words.push_back(glm::vec4(r.d, r.u));
+    }
+    gpu::Buffer rayBuffer(ctx(), words.size() * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "rays");
+    rayBuffer.upload(words.data(), words.size() * sizeof(glm::vec4));
+    gpu::Buffer out(ctx(), rays.size() * sizeof(Result), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "results");
+    // Bindings 5-7 (the frame's, lights', and the path tracer's) are not in the kernel; the
+    // table's storage buffers there get the result buffer so that every binding is valid.
+    for (uint32_t b = shared::BIND_VOLUME_COUNTERS + 1; b < shared::BIND_MEAN_FIELD; ++b) pass.set.bind(b, out);
+    pass.set.bind(rayBinding, rayBuffer);
+    pass.set.bind(resultBinding, out);
+    const uint32_t count = uint32_t(rays.size());
+    ctx().submitAndWait([&](VkCommandBuffer cmd) { pass.record(cmd, glm::uvec3(count, 1, 1), &count); });
+    std::vector<Result> res(rays.size());
+    out.download(res.data(), res.size() * sizeof(Result));
+    EXPECT_EQ(volume.truncatedCount(), 0u);
+    return res;
+  }
+
+  // Rays from outside the volume towards a point inside, and from points inside; a quarter with
+  // a finite tMax.
+  static std::vector<Ray> makeRays(const BakedVolume& vol, int n, unsigned seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> U(0.0f, 1.0f);
+    const glm::vec3 lo = vol.worldBoundsMin, hi = vol.worldBoundsMax, c = 0.5f * (lo + hi);
+    const float radius = glm::length(hi - lo);
+    std::vector<Ray> rays;
+    for (int i = 0; i < n; ++i) {
+      const glm::vec3 inside = lo + glm::vec3(U(rng), U(rng), U(rng)) * (hi - lo);
+      Ray r;
+      if (i % 2 == 0) {
+        const float z = 2.0f * U(rng) - 1.0f, phi = 6.2831853f * U(rng), s = std::sqrt(1.0f - z * z);
+        r.o = c + radius * glm::vec3(s * std::cos(phi), s * std::sin(phi), z);
+        r.d = glm::normalize(inside - r.o);
+      } else {
+        r.o = inside;
+        const float z = 2.0f * U(rng) - 1.0f, phi = 6.2831853f * U(rng), s = std::sqrt(1.0f - z * z);
+        r.d = glm::vec3(s * std::cos(phi), s * std::sin(phi), z);
+      }
+      if (i % 8 == 3) r.d = glm::normalize(glm::vec3(r.d.x, 0.0f, r.d.z));  // along a voxel face's plane
+      r.tMax = (i % 4 == 1) ? radius * U(rng) : 3.0e38f;
+      r.u = U(rng);
+      rays.push_back(r);
+    }
+    return rays;
+  }
+
+  // Checks every ray; returns the number of exact voxels the CPU integration met (so a test can
+  // say it covered them).
+  int expectWalksMatch(const BakedVolume& bake, float scale, int n, unsigned seed) {
+    const std::vector<Ray> rays = makeRays(bake, n, seed);
+    const std::vector<Result> res = run(bake, scale, rays);
+    int tauFail = 0, sampleFail = 0, hits = 0, exactHits = 0;
+    double worstTau = 0.0, worstSample = 0.0;
+    for (size_t i = 0; i < rays.size(); ++i) {
+      const Ray& r = rays[i];
+      double t0, t1;
+      clip(bake, r, t0, t1);
+      const double tau = t1 > t0 ? cpuTau(bake, scale, r, std::min<double>(t1, r.tMax)) : 0.0;
+      // The depth walk stops once past kMaxTau: beyond, only "at least kMaxTau" is asked.
+      const double tol = 2e-3 * tau + 1e-4;
+      const double errTau = tau < kMaxTau ? std::abs(res[i].tau - tau) / (tau + 1e-3) : 0.0;
+      if (tau < kMaxTau ? std::abs(res[i].tau - tau) > tol : res[i].tau < kMaxTau * (1.0 - 2e-3)) {
+        if (++tauFail <= 5) ADD_FAILURE() << "ray " << i << ": tau " << res[i].tau << ", CPU " << tau;
+      }
+      worstTau = std::max(worstTau, errTau);
+      // The collision: hit exactly when the field's depth over the ray reaches -log(1 - u), at
+      // the distance where it does, with the field's value there.
+      const double target = -std::log(1.0 - double(r.u));
+      const bool cpuHit = tau >= target;
+      if (std::abs(tau - target) <= tol) continue;  // too close to call
+      if ((res[i].t >= 0.0f) != cpuHit) {
+        if (++sampleFail <= 5) ADD_FAILURE() << "ray " << i << ": hit " << (res[i].t >= 0.0f) << ", CPU depth " << tau << " against " << target;
+        continue;
+      }
+      if (!cpuHit) continue;
+      ++hits;
+      const double tauAt = cpuTau(bake, scale, r, res[i].t);
+      const double errSample = std::abs(tauAt - target) / target;
+      worstSample = std::max(worstSample, errSample);
+      if (std::abs(tauAt - target) > 2e-3 * target + 1e-4) {
+        if (++sampleFail <= 5) ADD_FAILURE() << "ray " << i << ": collision at depth " << tauAt << ", asked " << target;
+        continue;
+      }
+      const glm::vec3 p = glm::vec3(bake.worldToIndex * glm::vec4(r.o + res[i].t * r.d, 1.0f));
+      const glm::vec3 dI = glm::mat3(bake.worldToIndex) * r.d;
+      bool exact = false;
+      const float sigma = fieldAt(bake, scale, p, dI, &exact);
+      exactHits += exact ? 1 : 0;
+      // On a voxel face the two sides' values may differ: accept either neighbour along the ray.
+      const float before = fieldAt(bake, scale, p - 1e-3f * dI, dI), after = fieldAt(bake, scale, p + 1e-3f * dI, dI);
+      const auto near = [&](float s) { return std::abs(res[i].sigma - s) <= 2e-3f * s + 1e-5f; };
+      if (!(near(sigma) || near(before) || near(after))) {
+        if (++sampleFail <= 5) ADD_FAILURE() << "ray " << i << ": sigma at the collision " << res[i].sigma << ", CPU " << sigma;
+      }
+    }
+    std::printf("[mean field walk] scale %g: %zu rays, %d collisions (%d in exact voxels); worst relative error: depth %.2e, "
+                "depth at the collision %.2e; failures %d / %d\n",
+                scale, rays.size(), hits, exactHits, worstTau, worstSample, tauFail, sampleFail);
+    EXPECT_EQ(tauFail, 0);
+    EXPECT_EQ(sampleFail, 0);
+    EXPECT_GT(hits, n / 8);
+    return exactHits;
+  }
+};
+
+}  // namespace
+
+// A smooth cloud at a density where no voxel is exact: the voxel means alone, across bricks.
+TEST_F(MeanFieldWalk, DepthAndCollisionsFollowTheVoxelMeans) {
+  LoadedGrid loaded;
+  loaded.grid = test::makeNoiseGrid(40, 0.05);
+  const BakedVolume bake = bakeVolume(loaded);
+  EXPECT_EQ(expectWalksMatch(bake, 4.0f, 2048, 11), 0);
+}
+
+// The same cloud forty times denser: voxels near steep gradients become exact (the trilinear
+// density integrated and inverted in closed form) among ordinary ones.
+TEST_F(MeanFieldWalk, DepthAndCollisionsFollowExactVoxelsWhereTheMeanStrays) {
+  LoadedGrid loaded;
+  loaded.grid = test::makeNoiseGrid(40, 0.05);
+  const BakedVolume bake = bakeVolume(loaded);
+  EXPECT_GT(expectWalksMatch(bake, 160.0f, 2048, 12), 20);
+}
