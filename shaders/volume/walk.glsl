@@ -334,6 +334,26 @@ void vol_track_event(uint tracker, inout VolTrack s, uint v, float scale, vec3 p
 #define VOL_KC_ARG
 #endif
 
+// One draw of a segment's tentative collisions at rate mu, from t on: true where the collision
+// falls before the segment's end b (h: its four numbers, h.y the event's u); otherwise the
+// segment is over (inSegment turns false) or the step cap ended the walk (s.stop).
+bool vol_draw_collision(inout VolTrack s, inout float t, float b, float mu, inout bool inSegment, inout uint steps,
+                        inout RngState rng, out uvec4 h VOL_KC_PARAM) {
+  h = uvec4(0u);
+  if (++steps > VOL_MAX_STEPS) {
+    s.stop = true;
+    return false;
+  }
+#ifdef PLUME_KERNEL_COUNTERS
+  vol_kc_step(kc);
+#endif
+  h = rng_next4(rng);
+  t -= log(1.0f - rng_to_float(h.x)) / mu;
+  if (t < b) return true;
+  inSegment = false;
+  return false;
+}
+
 // The walk's loops. A SIMD back end runs a loop's whole body on every iteration while any lane
 // needs it (../shared/docs/LAVAPIPE.md), so which code shares a loop matters. The majorant field
 // (delta and ratio tracking) is walked by collision: the outer loop makes one tentative
@@ -353,20 +373,11 @@ void vol_track_by_collision(uint tracker, uint v, inout VolTrack s, inout VolWal
     uvec4 h = uvec4(0u);
     for (;;) {
       if (inSegment) {
-        if (++steps > VOL_MAX_STEPS) {
-          s.stop = true;
-          break;
-        }
-#ifdef PLUME_KERNEL_COUNTERS
-        vol_kc_step(kc);
-#endif
-        h = rng_next4(rng);
-        t -= log(1.0f - rng_to_float(h.x)) / mu;
-        if (t < b) {
+        if (vol_draw_collision(s, t, b, mu, inSegment, steps, rng, h VOL_KC_ARG)) {
           found = true;
           break;
         }
-        inSegment = false;
+        if (s.stop) break;
       } else {
         // A segment is entered only where the tracker still needs one.
         if (!vol_track_alive(tracker, s) || !vol_walk_next(w, a, b, value)) break;
@@ -506,20 +517,11 @@ void vol_track_mean_residual(uint tracker, uint v, inout VolTrack s, inout VolWa
     }
     for (;;) {
       if (inSegment) {
-        if (++steps > VOL_MAX_STEPS) {
-          s.stop = true;
-          break;
-        }
-#ifdef PLUME_KERNEL_COUNTERS
-        vol_kc_step(kc);
-#endif
-        h = rng_next4(rng);
-        t -= log(1.0f - rng_to_float(h.x)) / mu;
-        if (t < b) {
+        if (vol_draw_collision(s, t, b, mu, inSegment, steps, rng, h VOL_KC_ARG)) {
           pending = VOL_PENDING_EVENT;
           break;
         }
-        inSegment = false;
+        if (s.stop) break;
       } else {
         bool exact;
         if (!vol_track_alive(tracker, s)) break;
