@@ -320,6 +320,10 @@ Light skyMapLight(glm::vec3 up, float rotateYDeg, float scale) {
 }
 }  // namespace
 
+// The reference takes 4096 samples: at 1024 a few edge pixels, where the map's bright texels are
+// rare and large contributions, read low in the reference, and the per-pixel test failed there
+// against the unchanged shaders too at 4x the runs (worst pixel z 7.1 and 4.3 for two reference
+// seeds; session 15: the stratified candidates' new draws met it at the default runs, z 4.5).
 TEST_F(GpuRestir, SkyMapWithReuseMatchesReference) {
   Scene s = baseScene(16);
   s.lights = {skyMapLight({0, 1, 0}, 0.0f, 1.0f)};
@@ -329,7 +333,7 @@ TEST_F(GpuRestir, SkyMapWithReuseMatchesReference) {
   RunSpec spec;
   spec.framesPerRun = 3;
   RestirRun run = runRestir(ctx(), compiler(), s, o, spec, [&](int) { return grid; });
-  expectMatches(run, reference(s, grid, 1024), "sky_map");
+  expectMatches(run, reference(s, grid, 4096), "sky_map");
 }
 
 TEST_F(GpuRestir, RotatedSkyMapAndSunMatchReference) {

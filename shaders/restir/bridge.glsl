@@ -122,14 +122,17 @@ float rs_emitter_light_pdf(uint prim, vec3 o, float dist, float cosLight) {
   return lightChoice[frame.lightCount].probability * surf_emitter_pdf_at(prim, o) * dist * dist / cosLight;
 }
 
+// pdfDir of a camera ray: no light sample reaches the camera, so its hit is weighted 1.
+const float RS_CAMERA_RAY = -1.0f;
+
 // The emission of a hit on triangle prim at distance t along w from the ray origin o of a vertex
 // whose direction sampling has density pdfDir there (vtx_at_pdf), with its MIS weight: the
-// direction-sampling part of an emitter's light.
+// direction-sampling part of an emitter's light (all of it for a camera ray, RS_CAMERA_RAY).
 vec3 rs_emitter_hit(float pdfDir, uint prim, vec3 o, vec3 w, float t) {
   vec3 n = surf_normal(prim);
   vec3 Le = surf_emitted(prim, n, w);
   float pl = rs_emitter_light_pdf(prim, o, t, abs(dot(n, w)));
-  return Le * rs_emitter_weight(pdfDir, pl);
+  return Le * (pdfDir == RS_CAMERA_RAY ? 1.0f : rs_emitter_weight(pdfDir, pl));
 }
 #endif
 
@@ -400,7 +403,9 @@ vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool unbiased, 
 #ifdef PLUME_HAS_SURFACES
     if (kind == VERTEX_SURFACE) {
 #ifdef PLUME_HAS_EMITTERS
-      if (h.light == RS_LIGHT_EMITTER_HIT && i == n) return f * tr * rs_emitter_hit(vtx_at_pdf(prev, w), hit.prim, o, w, t);
+      if (h.light == RS_LIGHT_EMITTER_HIT && i == n) {
+        return f * tr * rs_emitter_hit(i >= 2u ? vtx_at_pdf(prev, w) : RS_CAMERA_RAY, hit.prim, o, w, t);
+      }
 #endif
       vec3 ng = surf_normal(hit.prim);
       vx = vtx_surface(x, w, hit.prim, surf_shading_normal(hit.prim, vec2(hit.u, hit.v), ng));

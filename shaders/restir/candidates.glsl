@@ -16,7 +16,10 @@
 // its own emission (sigma_a Le at x_j, pdf without a light factor; light = RS_LIGHT_EMISSION), up
 // to vertex max_bounces + 1: both ends go through the one reservoir, so reuse shares good
 // emitters too. Emission seen directly (a one-vertex path) is final shading's, by tracking along
-// the camera ray (restir/shade.glsl): every path is counted once.
+// the camera ray (restir/shade.glsl): every path is counted once. With emissive surfaces every
+// surface vertex ends a candidate with the emitter it is (its direction-sampling part, MIS'd
+// against the light samples; the camera ray's hit, j = 1, whole), so a lamp seen directly is
+// reused like the light it casts.
 // The reservoir's confidence is M. A dispatch walks rsp.walksPerDispatch of the M walks
 // (lavapipe's loop budget, docs/architecture.md: an invocation walks at most
 // RS_CANDIDATE_VERTICES vertices, or one walk of K, whatever M): the walks stream their
@@ -75,9 +78,19 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
     head = rs_load_head(outSet, pixelIndex);
   }
   vec4 walk[RS_MAX_VERTICES - 1u];
+  // The walks' sub-pixel positions are stratified: walk m draws its own cell of a cols x rows
+  // grid of the pixel (cols rows = M, cols the largest divisor of M up to sqrt(M)). Its candidates
+  // have density M p_rest on that cell and 0 elsewhere; with the MIS weights "1 if the path's
+  // (u, v) lies in walk m's cell" (a partition of unity) each candidate's weight is
+  // f / (M p_rest), the formula of M uniform positions. A lamp seen directly over a few percent
+  // of the pixel is found far more evenly.
+  uint cols = uint(sqrt(float(M)));
+  while (cols > 1u && M % cols != 0u) --cols;
+  vec2 cellSize = vec2(1.0f / float(cols), float(cols) / float(M));
   uint last = min(first + rsp.walksPerDispatch, M);
   for (uint m = first; m < last; ++m) {
-    uint uv = rs_pack_uv(rng_float2(rng));  // the sub-pixel position: pdf 1 on the pixel
+    vec2 cell = vec2(float(m % cols), float(m / cols));
+    uint uv = rs_pack_uv(min((cell + rng_float2(rng)) * cellSize, vec2(1.0f)));  // the sub-pixel position
     vec3 x = D.origin;
     vec3 w = rs_domain_dir(D, rs_unpack_uv(uv));
     vec3 f = vec3(1.0f);  // prefix of f_D with coarse transmittance (the target's)
@@ -122,9 +135,9 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
         kinds |= 1u << (j - 1u);
 #ifdef PLUME_HAS_EMITTERS
         // The candidate ending with the emitter this direction hits (its direction-sampling
-        // part, rs_emitter_hit); a camera ray's hit is final shading's.
-        if (j >= 2u) {
-          float ph = rs_luminance(f * rs_emitter_hit(vtx_at_pdf(prev, w), hit.prim, o, w, t));
+        // part, rs_emitter_hit; all of it for the camera ray, j = 1: a lamp seen directly).
+        {
+          float ph = rs_luminance(f * rs_emitter_hit(j >= 2u ? vtx_at_pdf(prev, w) : RS_CAMERA_RAY, hit.prim, o, w, t));
           if (rs_update(r, invM * ph / pdf, ph, 0.0f, rng_float(rng))) {
             head = rs_candidate_head(uv, t1, j, kinds, RS_LIGHT_EMITTER_HIT, vec2(0.0f), 0u);
             keep = j;

@@ -95,6 +95,25 @@ inline Scene emissiveQuadsScene(int size, int bounces, float lowQuadHeight = 0.0
   return s;
 }
 
+// The ground scene lit by small lamps facing the camera, seen directly: six in front of the
+// cloud and six behind it (seen through it, lighting it from behind), each 4 cm wide (a few
+// percent of a 16² image's pixel), one 30 cm lamp in front, and a dim sky. Most of the lamp
+// pixels' value is the one-segment path camera -> lamp, which covers a small part of the pixel.
+inline Scene lampsSeenDirectlyScene(int size, int bounces) {
+  Scene s = smokeOverGroundScene(size, bounces);
+  s.lights = {skyLight({0.02f, 0.025f, 0.03f})};
+  const glm::vec3 toCamera = glm::normalize(s.camera.base.position - glm::vec3(1.0f, 0.8f, 1.0f));
+  const float xs[3] = {0.35f, 1.0f, 1.65f};
+  for (int i = 0; i < 6; ++i) {
+    const glm::vec3 front(xs[i % 3], 0.35f + 0.8f * float(i / 3), 2.3f);
+    const glm::vec3 back(xs[i % 3] + 0.2f, 0.5f + 0.8f * float(i / 3), -0.2f);
+    s.surfaces.push_back(emitterSurface(front, toCamera, {0.04f, 0.04f}, {40.0f, 32.0f, 24.0f}));
+    s.surfaces.push_back(emitterSurface(back, toCamera, {0.04f, 0.04f}, {30.0f, 36.0f, 48.0f}));
+  }
+  s.surfaces.push_back(emitterSurface({0.6f, 1.9f, 2.4f}, toCamera, {0.3f, 0.3f}, {6.0f, 6.0f, 6.0f}));
+  return s;
+}
+
 // A thin cloud over the ground between a white wall (x = 0.3, facing +x) and a glowing wall
 // (x = 1.7, emitting towards -x, the only light but a dim sky), and a black fin between them
 // (x = 1) as high as both, seen from above. The ground right of the fin sees the glowing wall
