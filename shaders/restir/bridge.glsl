@@ -125,6 +125,15 @@ float rs_emitter_light_pdf(uint prim, vec3 o, float dist, float cosLight) {
 // pdfDir of a camera ray: no light sample reaches the camera, so its hit is weighted 1.
 const float RS_CAMERA_RAY = -1.0f;
 
+// Lamps seen directly (camera rays on emitters, one-vertex paths): RS_DIRECT_RAYS rays stratified
+// over a RS_DIRECT_SIDE² grid of the pixel, as candidates of their own where domain D's frame
+// puts them in the reservoirs (rs_direct_lamps; restir/candidates.glsl), by final shading
+// otherwise (restir/shade.glsl). In the second kind of frame f_D of such a path is 0.
+const uint RS_DIRECT_SIDE = 4u;
+const uint RS_DIRECT_RAYS = RS_DIRECT_SIDE * RS_DIRECT_SIDE;
+
+bool rs_direct_lamps(RsDomain D) { return (D.v == VOL_PREVIOUS ? rsp.prevDirectLamps : rsp.directLamps) != 0u; }
+
 // The emission of a hit on triangle prim at distance t along w from the ray origin o of a vertex
 // whose direction sampling has density pdfDir there (vtx_at_pdf), with its MIS weight: the
 // direction-sampling part of an emitter's light (all of it for a camera ray, RS_CAMERA_RAY).
@@ -327,6 +336,9 @@ vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool unbiased, 
   RsPathHead h = rs_load_head(set, pixelIndex);
   uint n = h.vertexCount;
   if (n == 0u) return vec3(0.0f);
+#ifdef PLUME_HAS_EMITTERS
+  if (n == 1u && h.light == RS_LIGHT_EMITTER_HIT && !rs_direct_lamps(D)) return vec3(0.0f);  // final shading's
+#endif
   uint base = rs_bounce_base(set, pixelIndex);
   vec3 x = D.origin;
   vec3 w = rs_domain_dir(D, rs_unpack_uv(h.uv));

@@ -17,9 +17,10 @@
 // to vertex max_bounces + 1: both ends go through the one reservoir, so reuse shares good
 // emitters too. Emission seen directly (a one-vertex path) is final shading's, by tracking along
 // the camera ray (restir/shade.glsl): every path is counted once. With emissive surfaces every
-// surface vertex ends a candidate with the emitter it is (its direction-sampling part, MIS'd
-// against the light samples; the camera ray's hit, j = 1, whole), so a lamp seen directly is
-// reused like the light it casts.
+// surface vertex from the second on ends a candidate with the emitter it is (its
+// direction-sampling part, MIS'd against the light samples), and with a still camera and no
+// spatial reuse the emitters seen directly are candidates of their own
+// (rs_direct_emitter_candidates), so a lamp seen directly is reused like the light it casts.
 // The reservoir's confidence is M. A dispatch walks rsp.walksPerDispatch of the M walks
 // (lavapipe's loop budget, docs/architecture.md: an invocation walks at most
 // RS_CANDIDATE_VERTICES vertices, or one walk of K, whatever M): the walks stream their
@@ -44,7 +45,37 @@ RsPathHead rs_candidate_head(uint uv, float t1, uint j, uint kinds, uint light, 
   return h;
 }
 
-// Walks first .. first + rsp.walksPerDispatch - 1 (at most M - 1) of the pixel's M.
+#ifdef PLUME_HAS_EMITTERS
+// Lamps seen directly, in a frame whose reservoirs hold them (rs_direct_lamps: a still camera
+// with a history, no spatial reuse): the paths of one vertex on an emitter's front side (light
+// RS_LIGHT_EMITTER_HIT, weight 1: no light sample reaches the camera) are produced by these
+// candidates alone, RS_DIRECT_RAYS camera rays stratified over a RS_DIRECT_SIDE² grid of the
+// pixel, not by the walks (whose camera-ray hits end no candidate). Ray i has density
+// RS_DIRECT_RAYS on its cell; with the MIS weights "1 if the path's (u, v) lies in cell i" its
+// candidate's weight is f / RS_DIRECT_RAYS, f = Le times the mean field's transmittance (the
+// target's). A small lamp covers a few percent of a pixel: the reservoir and its reuse average
+// these rays over the history (up to c x 16 frames' worth of them), where final shading's own
+// 16 rays (sessions 9-14, and still with a moving camera) have only the frame's.
+void rs_direct_emitter_candidates(RsDomain D, inout RsReservoir r, inout RsPathHead head, inout RngState rng) {
+  for (uint i = 0u; i < RS_DIRECT_RAYS; ++i) {
+    vec2 cell = vec2(float(i % RS_DIRECT_SIDE), float(i / RS_DIRECT_SIDE));
+    uint uv = rs_pack_uv(min((cell + rng_float2(rng)) * (1.0f / float(RS_DIRECT_SIDE)), vec2(1.0f)));
+    vec3 dir = rs_domain_dir(D, rs_unpack_uv(uv));
+    BvhHit hit = bvh_closest(D.origin, dir, 0.0f, SURF_FAR);
+    float ph = 0.0f;
+    if (hit.prim != BVH_NONE) {
+      ph = rs_luminance(rs_emitter_hit(RS_CAMERA_RAY, hit.prim, D.origin, dir, hit.t));
+      if (ph > 0.0f) ph *= vol_mean_tr(VOL_CURRENT, D.origin, dir, hit.t);
+    }
+    if (rs_update(r, ph * (1.0f / float(RS_DIRECT_RAYS)), ph, 0.0f, rng_float(rng))) {
+      head = rs_candidate_head(uv, hit.t, 1u, 1u, RS_LIGHT_EMITTER_HIT, vec2(0.0f), 0u);
+    }
+  }
+}
+#endif
+
+// Walks first .. first + rsp.walksPerDispatch - 1 (at most M - 1) of the pixel's M; the first
+// dispatch also shoots the camera rays for the lamps seen directly (rs_direct_emitter_candidates).
 void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
   RsDomain D = rs_current_domain(pixel);
   RngState rng = rng_init(pixel, frame.frameKey, RNG_STREAM_CANDIDATES, frame.seed);
@@ -77,20 +108,13 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
     rng.counter = floatBitsToUint(state.z);
     head = rs_load_head(outSet, pixelIndex);
   }
+#ifdef PLUME_HAS_EMITTERS
+  if (first == 0u && rs_direct_lamps(D)) rs_direct_emitter_candidates(D, r, head, rng);
+#endif
   vec4 walk[RS_MAX_VERTICES - 1u];
-  // The walks' sub-pixel positions are stratified: walk m draws its own cell of a cols x rows
-  // grid of the pixel (cols rows = M, cols the largest divisor of M up to sqrt(M)). Its candidates
-  // have density M p_rest on that cell and 0 elsewhere; with the MIS weights "1 if the path's
-  // (u, v) lies in walk m's cell" (a partition of unity) each candidate's weight is
-  // f / (M p_rest), the formula of M uniform positions. A lamp seen directly over a few percent
-  // of the pixel is found far more evenly.
-  uint cols = uint(sqrt(float(M)));
-  while (cols > 1u && M % cols != 0u) --cols;
-  vec2 cellSize = vec2(1.0f / float(cols), float(cols) / float(M));
   uint last = min(first + rsp.walksPerDispatch, M);
   for (uint m = first; m < last; ++m) {
-    vec2 cell = vec2(float(m % cols), float(m / cols));
-    uint uv = rs_pack_uv(min((cell + rng_float2(rng)) * cellSize, vec2(1.0f)));  // the sub-pixel position
+    uint uv = rs_pack_uv(rng_float2(rng));  // the sub-pixel position: pdf 1 on the pixel
     vec3 x = D.origin;
     vec3 w = rs_domain_dir(D, rs_unpack_uv(uv));
     vec3 f = vec3(1.0f);  // prefix of f_D with coarse transmittance (the target's)
@@ -135,9 +159,10 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
         kinds |= 1u << (j - 1u);
 #ifdef PLUME_HAS_EMITTERS
         // The candidate ending with the emitter this direction hits (its direction-sampling
-        // part, rs_emitter_hit; all of it for the camera ray, j = 1: a lamp seen directly).
-        {
-          float ph = rs_luminance(f * rs_emitter_hit(j >= 2u ? vtx_at_pdf(prev, w) : RS_CAMERA_RAY, hit.prim, o, w, t));
+        // part, rs_emitter_hit); the camera ray's hit is rs_direct_emitter_candidates' (a still
+        // camera) or final shading's.
+        if (j >= 2u) {
+          float ph = rs_luminance(f * rs_emitter_hit(vtx_at_pdf(prev, w), hit.prim, o, w, t));
           if (rs_update(r, invM * ph / pdf, ph, 0.0f, rng_float(rng))) {
             head = rs_candidate_head(uv, t1, j, kinds, RS_LIGHT_EMITTER_HIT, vec2(0.0f), 0u);
             keep = j;

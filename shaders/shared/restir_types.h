@@ -103,8 +103,13 @@ struct RestirParams {
   // (0, 0), each round's one neighbour is the pixel at this offset (neighbours is 1)
   int fixedNeighbourX;
   int fixedNeighbourY;
-  uint pad0;
-  uint pad1;
+  // Lamps seen directly (emissive triangles hit by the camera ray; restir/candidates.glsl
+  // rs_direct_emitter_candidates): 1 when this frame's reservoirs hold them (a still camera with
+  // a history, no spatial reuse: render/restir.cpp says why), 0 when final shading's own rays do
+  // (restir/shade.glsl); the previous frame's choice beside it (its domain's target is 0 for
+  // such paths when it was 0).
+  uint directLamps;
+  uint prevDirectLamps;
 };
 
 // Push constants: which reservoir sets a pass reads and writes.

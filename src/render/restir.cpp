@@ -252,8 +252,20 @@ void Restir::fillFrame(int frame, uint32_t sequence, uint32_t key) {
   // The history's domain is the current one (a still camera over the grid it was rendered with):
   // the temporal shift is the identity and both cross-domain targets are the stored ones.
   const bool still = sameCamera(prevCam_, cam);
-  params_.historySameDomain =
-      history && still && previousSerial_ == currentSerial_ && renderedSerial_ == currentSerial_ ? 1u : 0u;
+  // Lamps seen directly go through the reservoirs only where the history keeps them (a still
+  // camera: the copied (u, v) finds the same lamp; a moving camera's history would lose them, and
+  // with them the rest of the light its reservoir stood for) and no spatial reuse runs (a lamp
+  // pixel's reservoir then mostly holds its lamp path, which fails the shift into every
+  // neighbour: their reuse turns heavy-tailed, notes/city.md "Session 15"); final shading takes
+  // them otherwise.
+  const bool directLamps = history && still && options_.rounds == 0;
+  params_.prevDirectLamps = history && directLamps_ ? 1u : 0u;
+  params_.directLamps = directLamps ? 1u : 0u;
+  directLamps_ = directLamps;
+  params_.historySameDomain = history && still && previousSerial_ == currentSerial_ &&
+                                      renderedSerial_ == currentSerial_ && params_.directLamps == params_.prevDirectLamps
+                                  ? 1u
+                                  : 0u;
   renderedSerial_ = currentSerial_;
   params_.reprojectionDepth = glm::length(centre_ - cam.position);
   frameBuffer_.upload(&frame_, sizeof(frame_));

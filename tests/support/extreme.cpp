@@ -191,7 +191,7 @@ EstimatorRun runRestirCase(gpu::Context& ctx, gpu::ShaderCompiler& compiler, con
 }
 
 EstimatorRun runRestirCase(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const ExtremeCase& c, int runs,
-                           const RestirOptions& o) {
+                           const RestirOptions& o, int framesPerRun) {
   const auto start = Clock::now();
   LoadedGrid loaded;
   loaded.grid = c.grid;
@@ -207,7 +207,8 @@ EstimatorRun runRestirCase(gpu::Context& ctx, gpu::ShaderCompiler& compiler, con
   EstimatorRun run;
   for (int r = 0; r < runs; ++r) {
     restir.resetHistory();
-    const Image im = restir.renderFrame(1, uint32_t(r + 1));
+    Image im;
+    for (int f = 1; f <= framesPerRun; ++f) im = restir.renderFrame(f, uint32_t(r + 1));
     glm::dvec3 m(0.0);
     for (size_t i = 0; i < n; ++i) {
       sum[i] += im.rgb[i], sum2[i] += double(im.rgb[i]) * im.rgb[i];

@@ -61,9 +61,10 @@ EstimatorRun runPtCase(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const E
 // (radius 2, one round, no history), so that per-pixel variances are honest.
 EstimatorRun runRestirCase(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const ExtremeCase& c, int runs,
                            uint32_t mis);
-// The same with any options (each run one frame from a reset history).
+// The same with any options (each run framesPerRun frames of the still scene from a reset
+// history, the last one measured).
 EstimatorRun runRestirCase(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const ExtremeCase& c, int runs,
-                           const RestirOptions& options);
+                           const RestirOptions& options, int framesPerRun = 1);
 
 uint64_t countNonFinite(const Image& image);
 

@@ -38,13 +38,14 @@ inline RestirOptions spatialReuse(uint32_t mis) {
 // ReSTIR (pairwise and GBH, or only `misKinds`; `runs` independent runs each)
 // against one reference of refSpp, with `base` (one spatial round by default;
 // its prefix, shift and neighbour choice kept, its MIS kind replaced by each
-// of misKinds).
+// of misKinds), each run the last of framesPerRun frames of a still camera.
 inline void expectRestirMatchesReference(
     gpu::Context &ctx, gpu::ShaderCompiler &compiler, const Scene &s,
     openvdb::FloatGrid::Ptr grid, int runs, int refSpp, const std::string &name,
     std::vector<uint32_t> misKinds = {shared::RS_MIS_PAIRWISE,
                                       shared::RS_MIS_GBH},
-    const RestirOptions &base = spatialReuse(shared::RS_MIS_PAIRWISE)) {
+    const RestirOptions &base = spatialReuse(shared::RS_MIS_PAIRWISE),
+    int framesPerRun = 1) {
   const Image ref = restirCheckReference(s, grid, refSpp);
   ExtremeCase c;
   c.name = name;
@@ -55,7 +56,7 @@ inline void expectRestirMatchesReference(
         name + (mis == shared::RS_MIS_GBH ? "_gbh" : "_pairwise") + (base.reconnect ? "" : "_copy");
     RestirOptions options = base;
     options.mis = mis;
-    const EstimatorRun run = runRestirCase(ctx, compiler, c, runs, options);
+    const EstimatorRun run = runRestirCase(ctx, compiler, c, runs, options, framesPerRun);
     ReferenceCheckOptions check;
     check.imageMeanVariance = run.imageMeanVariance;
     check.outputGroup = "restir_surfaces";
