@@ -2,9 +2,10 @@
 // transmittance (residual ratio tracking on the fine grid, every segment and the light ray) times
 // W = w_sum / p̂(Y); plus the radiance of the camera ray escaping the scene (light_escaped, also
 // by residual ratio tracking) and the medium's emission seen directly, which no reservoir path
-// covers (an emissive surface seen directly too, unless the frame's reservoirs hold it); plus, when max_bounces exceeds the prefix K that reservoirs hold (or, in an emitting
-// medium, max_bounces + 1 exceeds the emitting prefix rs_emission_vertices), the tail: the longer
-// paths, path traced. Requires restir/bridge.glsl.
+// covers (an emissive surface seen directly too, unless the frame's reservoirs hold it); plus,
+// when max_bounces exceeds the prefix K that reservoirs hold (or, in an emitting medium,
+// max_bounces + 1 exceeds the emitting prefix rs_emission_vertices), the tail: the longer paths,
+// path traced. Requires restir/bridge.glsl.
 #ifndef PLUME_RESTIR_SHADE_GLSL
 #define PLUME_RESTIR_SHADE_GLSL
 
@@ -137,9 +138,9 @@ vec3 rs_shade(RsDomain D, uint pixelIndex, uint set, inout RngState rng) {
 #if defined(PLUME_HAS_ENV) || defined(PLUME_HAS_EMITTERS)
   // The camera ray's end: the environment where it escapes (a surface blocks it), one-segment
   // paths, which no candidate ends with; with emissive surfaces also the emitter it hits, unless
-  // this frame's reservoirs hold those (rs_direct_lamps: a still camera, temporal reuse only), RS_DIRECT_RAYS rays
-  // stratified over the pixel (a small lamp covers a few percent of it; each ray: one BVH hit,
-  // the transmittance only where it sees light). 16 rather than 4 took the city's still-camera
+  // this frame's reservoirs hold those (rs_direct_lamps: a still camera, temporal reuse only):
+  // RS_DIRECT_RAYS rays stratified over the pixel (a small lamp covers a few percent of it; each
+  // ray: one BVH hit, the transmittance only where it sees light). 16 rather than 4 took the city's still-camera
   // relMSE from 0.668 to 0.264 (temporal reuse only; notes/city.md "Session 13").
 #ifdef PLUME_HAS_EMITTERS
   bool lamps = !rs_direct_lamps(D);

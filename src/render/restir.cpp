@@ -262,10 +262,9 @@ void Restir::fillFrame(int frame, uint32_t sequence, uint32_t key) {
   params_.prevDirectLamps = history && directLamps_ ? 1u : 0u;
   params_.directLamps = directLamps ? 1u : 0u;
   directLamps_ = directLamps;
-  params_.historySameDomain = history && still && previousSerial_ == currentSerial_ &&
-                                      renderedSerial_ == currentSerial_ && params_.directLamps == params_.prevDirectLamps
-                                  ? 1u
-                                  : 0u;
+  const bool sameVolume = previousSerial_ == currentSerial_ && renderedSerial_ == currentSerial_;
+  const bool sameLamps = params_.directLamps == params_.prevDirectLamps;
+  params_.historySameDomain = history && still && sameVolume && sameLamps ? 1u : 0u;
   renderedSerial_ = currentSerial_;
   params_.reprojectionDepth = glm::length(centre_ - cam.position);
   frameBuffer_.upload(&frame_, sizeof(frame_));
