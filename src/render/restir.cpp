@@ -258,10 +258,9 @@ void Restir::fillFrame(int frame, uint32_t sequence, uint32_t key) {
   // pixel's reservoir then mostly holds its lamp path, which fails the shift into every
   // neighbour: their reuse turns heavy-tailed, notes/city.md "Session 15"); final shading takes
   // them otherwise.
-  const bool directLamps = history && still && options_.rounds == 0;
-  params_.prevDirectLamps = history && directLamps_ ? 1u : 0u;
-  params_.directLamps = directLamps ? 1u : 0u;
-  directLamps_ = directLamps;
+  // (params_ still holds the previous frame's choice.)
+  params_.prevDirectLamps = history ? params_.directLamps : 0u;
+  params_.directLamps = history && still && options_.rounds == 0 ? 1u : 0u;
   const bool sameVolume = previousSerial_ == currentSerial_ && renderedSerial_ == currentSerial_;
   const bool sameLamps = params_.directLamps == params_.prevDirectLamps;
   params_.historySameDomain = history && still && sameVolume && sameLamps ? 1u : 0u;

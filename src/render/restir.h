@@ -112,7 +112,6 @@ class Restir {
   shared::RestirParams params_{};
   uint32_t history_ = 0;
   bool hasHistory_ = false;
-  bool directLamps_ = false;  // the previous frame's RestirParams::directLamps
   uint32_t prevSequence_ = 0;
   uint64_t currentSerial_ = 0, previousSerial_ = 0;  // volumes given to setVolumes
   uint64_t renderedSerial_ = 0;                      // the volume the history was rendered with
