@@ -323,7 +323,8 @@ Light skyMapLight(glm::vec3 up, float rotateYDeg, float scale) {
 // The reference takes 4096 samples: at 1024 a few edge pixels, where the map's bright texels are
 // rare and large contributions, read low in the reference, and the per-pixel test failed there
 // against the unchanged shaders too at 4x the runs (worst pixel z 7.1 and 4.3 for two reference
-// seeds; session 15: the stratified candidates' new draws met it at the default runs, z 4.5).
+// seeds; session 15: a first form of the lamp candidates, with other draws, met it at the
+// default runs, z 4.5).
 TEST_F(GpuRestir, SkyMapWithReuseMatchesReference) {
   Scene s = baseScene(16);
   s.lights = {skyMapLight({0, 1, 0}, 0.0f, 1.0f)};

@@ -57,10 +57,11 @@ TEST_F(GpuRestirSurfaces, EmissiveQuadsAsTheOnlyLightsMatchReference) {
 // of the image: with the candidates' hit weighted 0.7 instead of 1 the history runs fail (mean
 // ratio 0.73-0.76, aggregate z -30 to -33, worst pixel z -14); with the previous frame's domain
 // taken to hold lamps too (RestirParams::prevDirectLamps ignored: frame 2's canonical lamp paths
-// share their weight with a history that holds none) they read 0.70-0.91 (z -11 to -37). With spatial reuse in those frames as well the per-pixel
-// test failed in dim pixels beside the lamps (worst z -4.2 pairwise, -5.6 GBH, the method low
-// with a small variance: the rare, large reuse of a lamp pixel's non-lamp path), which is why
-// final shading keeps the lamps when spatial reuse runs.
+// share their weight with a history that holds none) they read 0.70-0.91 (z -11 to -37). With
+// spatial reuse in those frames as well the per-pixel test failed in dim pixels beside the lamps
+// (worst z -4.2 pairwise, -5.6 GBH, the method low with a small variance: the rare, large reuse
+// of a lamp pixel's non-lamp path), which is why final shading keeps the lamps when spatial
+// reuse runs.
 TEST_F(GpuRestirSurfaces, LampsSeenDirectlyMatchReference) {
   const Scene s = test::lampsSeenDirectlyScene(16, 3);
   const auto grid = test::makeNoiseGrid(32, 1.0 / 16, 7);

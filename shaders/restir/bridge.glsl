@@ -132,6 +132,12 @@ const float RS_CAMERA_RAY = -1.0f;
 const uint RS_DIRECT_SIDE = 4u;
 const uint RS_DIRECT_RAYS = RS_DIRECT_SIDE * RS_DIRECT_SIDE;
 
+// Ray i's sub-pixel position: a uniform point u of its cell of a side² grid of the pixel.
+vec2 rs_direct_uv(uint i, uint side, vec2 u) {
+  vec2 cell = vec2(float(i % side), float(i / side));
+  return min((cell + u) * (1.0f / float(side)), vec2(1.0f));
+}
+
 bool rs_direct_lamps(RsDomain D) { return (D.v == VOL_PREVIOUS ? rsp.prevDirectLamps : rsp.directLamps) != 0u; }
 
 // The emission of a hit on triangle prim at distance t along w from the ray origin o of a vertex

@@ -58,8 +58,7 @@ RsPathHead rs_candidate_head(uint uv, float t1, uint j, uint kinds, uint light, 
 // 16 rays (sessions 9-14, and still with a moving camera) have only the frame's.
 void rs_direct_emitter_candidates(RsDomain D, inout RsReservoir r, inout RsPathHead head, inout RngState rng) {
   for (uint i = 0u; i < RS_DIRECT_RAYS; ++i) {
-    vec2 cell = vec2(float(i % RS_DIRECT_SIDE), float(i / RS_DIRECT_SIDE));
-    uint uv = rs_pack_uv(min((cell + rng_float2(rng)) * (1.0f / float(RS_DIRECT_SIDE)), vec2(1.0f)));
+    uint uv = rs_pack_uv(rs_direct_uv(i, RS_DIRECT_SIDE, rng_float2(rng)));
     vec3 dir = rs_domain_dir(D, rs_unpack_uv(uv));
     BvhHit hit = bvh_closest(D.origin, dir, 0.0f, SURF_FAR);
     float ph = 0.0f;

@@ -149,8 +149,7 @@ vec3 rs_shade(RsDomain D, uint pixelIndex, uint set, inout RngState rng) {
   if (lamps)
 #endif
   for (uint i = 0u; i < side * side; ++i) {
-    vec2 cell = vec2(float(i % side), float(i / side));
-    vec3 dir = rs_domain_dir(D, (cell + rng_float2(rng)) * (1.0f / float(side)));
+    vec3 dir = rs_domain_dir(D, rs_direct_uv(i, side, rng_float2(rng)));
     BvhHit hit = bvh_closest(D.origin, dir, 0.0f, SURF_FAR);
     float tEnd = hit.prim != BVH_NONE ? hit.t : DDA_INF;
     vec3 Le = hit.prim != BVH_NONE ? (lamps ? surf_emitted(hit.prim, surf_normal(hit.prim), dir) : vec3(0.0f)) : light_escaped(dir);
