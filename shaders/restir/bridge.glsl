@@ -122,13 +122,9 @@ float rs_emitter_light_pdf(uint prim, vec3 o, float dist, float cosLight) {
   return lightChoice[frame.lightCount].probability * surf_emitter_pdf_at(prim, o) * dist * dist / cosLight;
 }
 
-// pdfDir of a camera ray: no light sample reaches the camera, so its hit is weighted 1.
-const float RS_CAMERA_RAY = -1.0f;
-
-// Lamps seen directly (camera rays on emitters, one-vertex paths): RS_DIRECT_RAYS rays stratified
-// over a RS_DIRECT_SIDE² grid of the pixel, as candidates of their own where domain D's frame
-// puts them in the reservoirs (rs_direct_lamps; restir/candidates.glsl), by final shading
-// otherwise (restir/shade.glsl). In the second kind of frame f_D of such a path is 0.
+// Lamps seen directly (camera rays on emitters, one-vertex paths) have a reservoir of their own
+// (restir/candidates.glsl rs_lamp_reservoir): RS_DIRECT_RAYS candidates stratified over a
+// RS_DIRECT_SIDE² grid of the pixel.
 const uint RS_DIRECT_SIDE = 4u;
 const uint RS_DIRECT_RAYS = RS_DIRECT_SIDE * RS_DIRECT_SIDE;
 
@@ -138,16 +134,14 @@ vec2 rs_direct_uv(uint i, uint side, vec2 u) {
   return min((cell + u) * (1.0f / float(side)), vec2(1.0f));
 }
 
-bool rs_direct_lamps(RsDomain D) { return (D.v == VOL_PREVIOUS ? rsp.prevDirectLamps : rsp.directLamps) != 0u; }
-
 // The emission of a hit on triangle prim at distance t along w from the ray origin o of a vertex
 // whose direction sampling has density pdfDir there (vtx_at_pdf), with its MIS weight: the
-// direction-sampling part of an emitter's light (all of it for a camera ray, RS_CAMERA_RAY).
+// direction-sampling part of an emitter's light.
 vec3 rs_emitter_hit(float pdfDir, uint prim, vec3 o, vec3 w, float t) {
   vec3 n = surf_normal(prim);
   vec3 Le = surf_emitted(prim, n, w);
   float pl = rs_emitter_light_pdf(prim, o, t, abs(dot(n, w)));
-  return Le * (pdfDir == RS_CAMERA_RAY ? 1.0f : rs_emitter_weight(pdfDir, pl));
+  return Le * rs_emitter_weight(pdfDir, pl);
 }
 #endif
 
@@ -292,6 +286,8 @@ void rs_store_head(uint set, uint pixelIndex, RsPathHead h) {
 // accumulation): the candidates' running reservoir (restir/candidates.glsl), then final
 // shading's tail (restir/shade.glsl).
 uint rs_state_slot(uint pixelIndex) { return 2u * rsp.pixelCount + RS_STATE_SLOTS * pixelIndex; }
+// A pixel's lamp reservoir of set `set` (RestirParams::lampSet), past the state.
+uint rs_lamp_slot(uint set, uint pixelIndex) { return (2u + RS_STATE_SLOTS + set) * rsp.pixelCount + pixelIndex; }
 
 // Vertex count of the stored path (0: none), and marking a slot empty.
 uint rs_path_length(uint set, uint pixelIndex) { return rsPathWords[2u * rs_slot(set, pixelIndex)].w; }
@@ -342,9 +338,6 @@ vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool unbiased, 
   RsPathHead h = rs_load_head(set, pixelIndex);
   uint n = h.vertexCount;
   if (n == 0u) return vec3(0.0f);
-#ifdef PLUME_HAS_EMITTERS
-  if (n == 1u && h.light == RS_LIGHT_EMITTER_HIT && !rs_direct_lamps(D)) return vec3(0.0f);  // final shading's
-#endif
   uint base = rs_bounce_base(set, pixelIndex);
   vec3 x = D.origin;
   vec3 w = rs_domain_dir(D, rs_unpack_uv(h.uv));
@@ -422,7 +415,7 @@ vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool unbiased, 
     if (kind == VERTEX_SURFACE) {
 #ifdef PLUME_HAS_EMITTERS
       if (h.light == RS_LIGHT_EMITTER_HIT && i == n) {
-        return f * tr * rs_emitter_hit(i >= 2u ? vtx_at_pdf(prev, w) : RS_CAMERA_RAY, hit.prim, o, w, t);
+        return f * tr * rs_emitter_hit(vtx_at_pdf(prev, w), hit.prim, o, w, t);  // i >= 2
       }
 #endif
       vec3 ng = surf_normal(hit.prim);

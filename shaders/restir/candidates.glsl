@@ -18,9 +18,8 @@
 // emitters too. Emission seen directly (a one-vertex path) is final shading's, by tracking along
 // the camera ray (restir/shade.glsl): every path is counted once. With emissive surfaces every
 // surface vertex from the second on ends a candidate with the emitter it is (its
-// direction-sampling part, MIS'd against the light samples), and with a still camera and no
-// spatial reuse the emitters seen directly are candidates of their own
-// (rs_direct_emitter_candidates), so a lamp seen directly is reused like the light it casts.
+// direction-sampling part, MIS'd against the light samples), and the emitters seen directly go
+// into a reservoir of their own (rs_lamp_reservoir), reused over time.
 // The reservoir's confidence is M. A dispatch walks rsp.walksPerDispatch of the M walks
 // (lavapipe's loop budget, docs/architecture.md: an invocation walks at most
 // RS_CANDIDATE_VERTICES vertices, or one walk of K, whatever M): the walks stream their
@@ -46,35 +45,66 @@ RsPathHead rs_candidate_head(uint uv, float t1, uint j, uint kinds, uint light, 
 }
 
 #ifdef PLUME_HAS_EMITTERS
-// Lamps seen directly, in a frame whose reservoirs hold them (rs_direct_lamps: a still camera
-// with a history, no spatial reuse): the paths of one vertex on an emitter's front side (light
-// RS_LIGHT_EMITTER_HIT, weight 1: no light sample reaches the camera) are produced by these
-// candidates alone, RS_DIRECT_RAYS camera rays stratified over a RS_DIRECT_SIDE² grid of the
-// pixel, not by the walks (whose camera-ray hits end no candidate). Ray i has density
-// RS_DIRECT_RAYS on its cell; with the MIS weights "1 if the path's (u, v) lies in cell i" its
-// candidate's weight is f / RS_DIRECT_RAYS, f = Le times the mean field's transmittance (the
-// target's). A small lamp covers a few percent of a pixel: the reservoir and its reuse average
-// these rays over the history (up to c x 16 frames' worth of them), where final shading's own
-// 16 rays (sessions 9-14, and still with a moving camera) have only the frame's.
-void rs_direct_emitter_candidates(RsDomain D, inout RsReservoir r, inout RsPathHead head, inout RngState rng) {
+// Lamps seen directly: the paths of one vertex on an emitter's front (a camera ray's hit, weight
+// 1: no light sample reaches the camera) have a reservoir of their own per pixel, not the light
+// paths' (whose walks' camera-ray hits end no candidate): a lamp pixel's light-path reservoir
+// then still stands for the light its neighbours reuse, and the lamp's own reservoir is reused
+// by the one pixel that sees it, over time (notes/city.md "Session 16"). Its sample is a
+// sub-pixel position (u, v); its target p̂_v(u, v) = Le x the mean field's transmittance of
+// volume v along the ray to the first surface (0 where that is no emitter's front). Final
+// shading adds W Le T along the sample's ray (restir/shade.glsl).
+float rs_lamp_target(RsDomain D, uint v, uint uv) {
+  vec3 dir = rs_domain_dir(D, rs_unpack_uv(uv));
+  BvhHit hit = bvh_closest(D.origin, dir, 0.0f, SURF_FAR);
+  if (hit.prim == BVH_NONE) return 0.0f;
+  float ph = rs_luminance(surf_emitted(hit.prim, surf_normal(hit.prim), dir));
+  return ph > 0.0f ? ph * vol_mean_tr(v, D.origin, dir, hit.t) : 0.0f;
+}
+
+// The frame's lamp reservoir of the pixel (set rsp.lampSet): RS_DIRECT_RAYS candidates, ray i
+// uniform on cell i of a RS_DIRECT_SIDE² grid of the pixel (density RS_DIRECT_RAYS there; MIS
+// weights "1 if (u, v) lies in cell i", a partition of the pixel), so candidate i's weight is
+// p̂(u_i, v_i) / RS_DIRECT_RAYS, confidence 1 in all. With a still camera the previous frame's
+// reservoir at the same pixel (its confidence capped at c) is merged in with the generalised
+// balance heuristic between the two domains, m_s(y) = M_s p̂_s(y) / Σ_j M_j p̂_j(y), p̂_s the
+// target with the volume input s was rendered with (the shift is the identity: the same (u, v)
+// in the same camera); with a still grid both targets are one function and m_s = M_s / ΣM. The
+// canonical input covers every (u, v) a lamp is seen through, so the merge is unbiased.
+void rs_lamp_reservoir(RsDomain D, uint pixelIndex, inout RngState rng) {
+  RsReservoir r = rs_empty();
+  uint uv = 0u;
   for (uint i = 0u; i < RS_DIRECT_RAYS; ++i) {
-    uint uv = rs_pack_uv(rs_direct_uv(i, RS_DIRECT_SIDE, rng_float2(rng)));
-    vec3 dir = rs_domain_dir(D, rs_unpack_uv(uv));
-    BvhHit hit = bvh_closest(D.origin, dir, 0.0f, SURF_FAR);
-    float ph = 0.0f;
-    if (hit.prim != BVH_NONE) {
-      ph = rs_luminance(rs_emitter_hit(RS_CAMERA_RAY, hit.prim, D.origin, dir, hit.t));
-      if (ph > 0.0f) ph *= vol_mean_tr(VOL_CURRENT, D.origin, dir, hit.t);
-    }
-    if (rs_update(r, ph * (1.0f / float(RS_DIRECT_RAYS)), ph, 0.0f, rng_float(rng))) {
-      head = rs_candidate_head(uv, hit.t, 1u, 1u, RS_LIGHT_EMITTER_HIT, vec2(0.0f), 0u);
-    }
+    uint c = rs_pack_uv(rs_direct_uv(i, RS_DIRECT_SIDE, rng_float2(rng)));
+    float ph = rs_lamp_target(D, VOL_CURRENT, c);
+    if (rs_update(r, ph * (1.0f / float(RS_DIRECT_RAYS)), ph, 0.0f, rng_float(rng))) uv = c;
   }
+  r.M = 1.0f;
+  rs_finalize(r);
+  if (rsp.lampHistory != 0u) {
+    vec4 stored = rsOutput[rs_lamp_slot(1u - rsp.lampSet, pixelIndex)];
+    RsReservoir h = rs_empty();
+    h.W = rs_is_finite(stored.x) && stored.x > 0.0f ? stored.x : 0.0f;
+    h.M = min(stored.y, rsp.historyCap);  // c x the canonical confidence 1
+    h.p_hat = stored.w;                   // in the history's domain
+    uint huv = floatBitsToUint(stored.z);
+    bool same = rsp.lampSameVolume != 0u;
+    // Each input's sample in the other domain: the canonical's p̂_prev, the history's p̂_cur.
+    float prevOfC = r.W > 0.0f ? (same ? r.p_hat : rs_lamp_target(D, VOL_PREVIOUS, uv)) : 0.0f;
+    float curOfH = h.W > 0.0f ? (same ? h.p_hat : rs_lamp_target(D, VOL_CURRENT, huv)) : 0.0f;
+    float mC = r.W > 0.0f ? r.p_hat / (r.p_hat + h.M * prevOfC) : 0.0f;
+    float mH = h.W > 0.0f && h.p_hat > 0.0f ? h.M * h.p_hat / (curOfH + h.M * h.p_hat) : 0.0f;
+    RsReservoir o = rs_empty();
+    rs_merge(o, r, r.p_hat, 1.0f, mC, rng_float(rng));
+    if (rs_merge(o, h, curOfH, 1.0f, mH, rng_float(rng))) uv = huv;
+    rs_finalize(o);
+    r = o;
+  }
+  rsOutput[rs_lamp_slot(rsp.lampSet, pixelIndex)] = vec4(r.W, r.M, uintBitsToFloat(uv), r.p_hat);
 }
 #endif
 
 // Walks first .. first + rsp.walksPerDispatch - 1 (at most M - 1) of the pixel's M; the first
-// dispatch also shoots the camera rays for the lamps seen directly (rs_direct_emitter_candidates).
+// dispatch also makes the pixel's lamp reservoir (rs_lamp_reservoir).
 void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
   RsDomain D = rs_current_domain(pixel);
   RngState rng = rng_init(pixel, frame.frameKey, RNG_STREAM_CANDIDATES, frame.seed);
@@ -108,7 +138,7 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
     head = rs_load_head(outSet, pixelIndex);
   }
 #ifdef PLUME_HAS_EMITTERS
-  if (first == 0u && rs_direct_lamps(D)) rs_direct_emitter_candidates(D, r, head, rng);
+  if (first == 0u) rs_lamp_reservoir(D, pixelIndex, rng);
 #endif
   vec4 walk[RS_MAX_VERTICES - 1u];
   uint last = min(first + rsp.walksPerDispatch, M);
@@ -158,8 +188,7 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
         kinds |= 1u << (j - 1u);
 #ifdef PLUME_HAS_EMITTERS
         // The candidate ending with the emitter this direction hits (its direction-sampling
-        // part, rs_emitter_hit); the camera ray's hit is rs_direct_emitter_candidates' (a still
-        // camera) or final shading's.
+        // part, rs_emitter_hit); the camera ray's hit is the lamp reservoir's (rs_lamp_reservoir).
         if (j >= 2u) {
           float ph = rs_luminance(f * rs_emitter_hit(vtx_at_pdf(prev, w), hit.prim, o, w, t));
           if (rs_update(r, invM * ph / pdf, ph, 0.0f, rng_float(rng))) {

@@ -2,7 +2,7 @@
 // transmittance (residual ratio tracking on the fine grid, every segment and the light ray) times
 // W = w_sum / p̂(Y); plus the radiance of the camera ray escaping the scene (light_escaped, also
 // by residual ratio tracking) and the medium's emission seen directly, which no reservoir path
-// covers (an emissive surface seen directly too, unless the frame's reservoirs hold it); plus,
+// covers; with emissive surfaces, the lamps seen directly from their reservoir of their own; plus,
 // when max_bounces exceeds the prefix K that reservoirs hold (or, in an emitting medium,
 // max_bounces + 1 exceeds the emitting prefix rs_emission_vertices), the tail: the longer paths,
 // path traced. Requires restir/bridge.glsl.
@@ -135,34 +135,28 @@ vec3 rs_shade(RsDomain D, uint pixelIndex, uint set, inout RngState rng) {
   RsReservoir r = rs_load(set, pixelIndex);
   vec3 L = vec3(0.0f);
   if (r.W > 0.0f) L += r.W * rs_path_contribution(D, set, pixelIndex, true, rng);
-#if defined(PLUME_HAS_ENV) || defined(PLUME_HAS_EMITTERS)
-  // The camera ray's end: the environment where it escapes (a surface blocks it), one-segment
-  // paths, which no candidate ends with; with emissive surfaces also the emitter it hits, unless
-  // this frame's reservoirs hold those (rs_direct_lamps: a still camera, temporal reuse only):
-  // RS_DIRECT_RAYS rays stratified over the pixel (a small lamp covers a few percent of it; each
-  // ray: one BVH hit, the transmittance only where it sees light). 16 rather than 4 took the city's still-camera
-  // relMSE from 0.668 to 0.264 (temporal reuse only; notes/city.md "Session 13").
 #ifdef PLUME_HAS_EMITTERS
-  bool lamps = !rs_direct_lamps(D);
-  uint side = lamps ? RS_DIRECT_SIDE : 1u;
-#ifndef PLUME_HAS_ENV
-  if (lamps)
-#endif
-  for (uint i = 0u; i < side * side; ++i) {
-    vec3 dir = rs_domain_dir(D, rs_direct_uv(i, side, rng_float2(rng)));
-    BvhHit hit = bvh_closest(D.origin, dir, 0.0f, SURF_FAR);
-    float tEnd = hit.prim != BVH_NONE ? hit.t : DDA_INF;
-    vec3 Le = hit.prim != BVH_NONE ? (lamps ? surf_emitted(hit.prim, surf_normal(hit.prim), dir) : vec3(0.0f)) : light_escaped(dir);
-    if (Le.x > 0.0f || Le.y > 0.0f || Le.z > 0.0f) L += (1.0f / float(side * side)) * Le * vol_residual_tr(D.origin, dir, tEnd, rng);
+  // The lamps seen directly: their reservoir's sample (restir/candidates.glsl rs_lamp_reservoir),
+  // W Le T along its ray, T by residual ratio tracking.
+  vec4 lamp = rsOutput[rs_lamp_slot(rsp.lampSet, pixelIndex)];
+  if (lamp.x > 0.0f) {
+    vec3 dirL = rs_domain_dir(D, rs_unpack_uv(floatBitsToUint(lamp.z)));
+    BvhHit hitL = bvh_closest(D.origin, dirL, 0.0f, SURF_FAR);
+    if (hitL.prim != BVH_NONE) {
+      vec3 Le = surf_emitted(hitL.prim, surf_normal(hitL.prim), dirL);
+      if (Le.x > 0.0f || Le.y > 0.0f || Le.z > 0.0f) L += lamp.x * Le * vol_residual_tr(D.origin, dirL, hitL.t, rng);
+    }
   }
-#else
+#endif
+#ifdef PLUME_HAS_ENV
+  // The camera ray escaping to the environment (a surface blocks it): one-segment paths, which
+  // no candidate ends with.
   vec3 dir = rs_domain_dir(D, rng_float2(rng));
 #ifdef PLUME_HAS_SURFACES
   BvhHit hit = bvh_closest(D.origin, dir, 0.0f, SURF_FAR);
   if (hit.prim == BVH_NONE) L += light_escaped(dir) * vol_residual_tr(D.origin, dir, DDA_INF, rng);
 #else
   L += light_escaped(dir) * vol_residual_tr(D.origin, dir, DDA_INF, rng);
-#endif
 #endif
 #endif
 #ifdef PLUME_HAS_EMISSION

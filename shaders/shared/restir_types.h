@@ -51,6 +51,9 @@ const uint RS_CANDIDATE_VERTICES = 64u;
 // vec4s per pixel of a pass's state between its dispatches (restir/bridge.glsl rs_state_slot):
 // the candidates' running reservoir (1), the tail's walk (5, restir/shade.glsl RsTail).
 const uint RS_STATE_SLOTS = 5u;
+// vec4s per pixel of the lamp reservoirs (RestirParams::lampSet) past the state, with emissive
+// surfaces only: (W, M, packed (u, v), p̂) of each of the two sets (restir/bridge.glsl rs_lamp_slot).
+const uint RS_LAMP_SLOTS = 2u;
 // rsCounters[] (restir/bindings.glsl): [0] reservoirs dropped for non-finite weights,
 // [RS_COUNTER_TAIL_ALIVE] tail walks still alive after a counting dispatch (Restir::render).
 const uint RS_COUNTERS = 4u;
@@ -103,13 +106,14 @@ struct RestirParams {
   // (0, 0), each round's one neighbour is the pixel at this offset (neighbours is 1)
   int fixedNeighbourX;
   int fixedNeighbourY;
-  // Lamps seen directly (emissive triangles hit by the camera ray; restir/candidates.glsl
-  // rs_direct_emitter_candidates): 1 when this frame's reservoirs hold them (a still camera with
-  // a history, no spatial reuse: render/restir.cpp says why), 0 when final shading's own rays do
-  // (restir/shade.glsl); the previous frame's choice beside it (its domain's target is 0 for
-  // such paths when it was 0).
-  uint directLamps;
-  uint prevDirectLamps;
+  // Lamps seen directly (emissive triangles hit by the camera ray): a reservoir of their own per
+  // pixel (restir/candidates.glsl rs_lamp_reservoir), two sets that alternate by frame.
+  uint lampSet;             // this frame's set (the history's is the other)
+  uint lampHistory;         // 1: the other set holds the previous frame's, same pixel (a still camera)
+  uint lampSameVolume;      // 1: ... rendered with this frame's volume (its target is this frame's)
+  uint pad0;
+  uint pad1;
+  uint pad2;
 };
 
 // Push constants: which reservoir sets a pass reads and writes.
@@ -172,7 +176,7 @@ PLUME_NS_END
 static_assert(sizeof(plume::shared::RsPathHead) == 32, "RsPathHead crosses the bus");
 static_assert(offsetof(plume::shared::RsPathHead, vertexCount) == 12, "RsPathHead layout");
 static_assert(offsetof(plume::shared::RestirParams, candidates) == 64, "RestirParams layout");
-static_assert(sizeof(plume::shared::RestirParams) == 64 + 4 * 16, "RestirParams layout");
+static_assert(sizeof(plume::shared::RestirParams) == 64 + 5 * 16, "RestirParams layout");
 static_assert(sizeof(plume::shared::RsPush) == 32, "RsPush layout");
 #endif
 

@@ -181,8 +181,10 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   paths_ = gpu::Buffer(ctx, kSets * pixels * sizeof(shared::RsPathHead), storage, "reservoir paths");
   bounces_ = gpu::Buffer(ctx, kSets * pixels * stride * sizeof(glm::vec4), storage, "reservoir path vertices");
   // The accumulation, then each pixel's state between the dispatches of a pass (the candidates'
-  // running reservoir, the tail's walk: restir/bridge.glsl rs_state_slot).
-  output_ = gpu::Buffer(ctx, (2 + shared::RS_STATE_SLOTS) * pixels * sizeof(glm::vec4), storage, "restir accumulation");
+  // running reservoir, the tail's walk: restir/bridge.glsl rs_state_slot), then with emissive
+  // surfaces the lamp reservoirs (rs_lamp_slot).
+  const size_t slots = 2 + shared::RS_STATE_SLOTS + (features_.emitters ? shared::RS_LAMP_SLOTS : 0);
+  output_ = gpu::Buffer(ctx, slots * pixels * sizeof(glm::vec4), storage, "restir accumulation");
   counters_ = gpu::Buffer(ctx, shared::RS_COUNTERS * sizeof(uint32_t), storage, "restir counters");
   counters_.fillZero();
   reservoirs_.fillZero();
@@ -252,18 +254,13 @@ void Restir::fillFrame(int frame, uint32_t sequence, uint32_t key) {
   // The history's domain is the current one (a still camera over the grid it was rendered with):
   // the temporal shift is the identity and both cross-domain targets are the stored ones.
   const bool still = sameCamera(prevCam_, cam);
-  // Lamps seen directly go through the reservoirs only where the history keeps them (a still
-  // camera: the copied (u, v) finds the same lamp; a moving camera's history would lose them, and
-  // with them the rest of the light its reservoir stood for) and no spatial reuse runs (a lamp
-  // pixel's reservoir then mostly holds its lamp path, which fails the shift into every
-  // neighbour: their reuse turns heavy-tailed, notes/city.md "Session 15"); final shading takes
-  // them otherwise.
-  // (params_ still holds the previous frame's choice.)
-  params_.prevDirectLamps = history ? params_.directLamps : 0u;
-  params_.directLamps = history && still && options_.rounds == 0 ? 1u : 0u;
   const bool sameVolume = previousSerial_ == currentSerial_ && renderedSerial_ == currentSerial_;
-  const bool sameLamps = params_.directLamps == params_.prevDirectLamps;
-  params_.historySameDomain = history && still && sameVolume && sameLamps ? 1u : 0u;
+  params_.historySameDomain = history && still && sameVolume ? 1u : 0u;
+  // The lamps seen directly (restir/candidates.glsl rs_lamp_reservoir): the sets alternate; the
+  // history is the same pixel's only with a still camera.
+  params_.lampSet ^= 1u;
+  params_.lampHistory = history && still ? 1u : 0u;
+  params_.lampSameVolume = sameVolume ? 1u : 0u;
   renderedSerial_ = currentSerial_;
   params_.reprojectionDepth = glm::length(centre_ - cam.position);
   frameBuffer_.upload(&frame_, sizeof(frame_));

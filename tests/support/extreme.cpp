@@ -193,13 +193,17 @@ EstimatorRun runRestirCase(gpu::Context& ctx, gpu::ShaderCompiler& compiler, con
 EstimatorRun runRestirCase(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const ExtremeCase& c, int runs,
                            const RestirOptions& o, int framesPerRun) {
   const auto start = Clock::now();
-  LoadedGrid loaded;
-  loaded.grid = c.grid;
-  loaded.name = "density";
-  const BakedVolume bake = bakeVolume(loaded);
-  GpuVolumeResources volume(ctx, bake, c.scene.media[0].densityScale);
+  auto upload = [&](openvdb::FloatGrid::Ptr grid) {
+    LoadedGrid loaded;
+    loaded.grid = grid;
+    loaded.name = "density";
+    return std::make_unique<GpuVolumeResources>(ctx, bakeVolume(loaded), c.scene.media[0].densityScale);
+  };
+  const std::unique_ptr<GpuVolumeResources> current = upload(c.grid);
+  const std::unique_ptr<GpuVolumeResources> previous = c.previousGrid ? upload(c.previousGrid) : nullptr;
+  const GpuVolumeResources& volume = *current;
+  const GpuVolumeResources& before = previous ? *previous : volume;
   Restir restir(ctx, compiler, c.scene, o);
-  restir.setVolumes(volume, volume);
   // Mean and variance of the mean over independent runs, per pixel and of the image mean.
   const size_t n = size_t(3) * c.scene.camera.width * c.scene.camera.height;
   std::vector<double> sum(n, 0.0), sum2(n, 0.0);
@@ -208,7 +212,11 @@ EstimatorRun runRestirCase(gpu::Context& ctx, gpu::ShaderCompiler& compiler, con
   for (int r = 0; r < runs; ++r) {
     restir.resetHistory();
     Image im;
-    for (int f = 1; f <= framesPerRun; ++f) im = restir.renderFrame(f, uint32_t(r + 1));
+    for (int f = 1; f <= framesPerRun; ++f) {
+      if (f < framesPerRun) restir.setVolumes(before, before);
+      else restir.setVolumes(volume, before);
+      im = restir.renderFrame(f, uint32_t(r + 1));
+    }
     glm::dvec3 m(0.0);
     for (size_t i = 0; i < n; ++i) {
       sum[i] += im.rgb[i], sum2[i] += double(im.rgb[i]) * im.rgb[i];
@@ -218,6 +226,7 @@ EstimatorRun runRestirCase(gpu::Context& ctx, gpu::ShaderCompiler& compiler, con
     meanSum += m, meanSum2 += m * m;
   }
   run.truncated = volume.truncatedCount() + volume.loopLimitCount() + restir.takeDroppedCount();
+  if (previous) run.truncated += previous->truncatedCount() + previous->loopLimitCount();
   run.image = Image(c.scene.camera.width, c.scene.camera.height, true);
   for (size_t i = 0; i < n; ++i) {
     const double mean = sum[i] / runs;

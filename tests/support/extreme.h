@@ -32,6 +32,10 @@ struct ExtremeCase {
   uint64_t replaced = 0, clamped = 0;  // by sanitizeGrid and clampOpticalDepth
   bool restir = true;                  // ReSTIR renders the case
   bool mediumInView = true;            // the medium covers a good part of the image
+  // ReSTIR over several frames (runRestirCase's framesPerRun > 1) only: when set, every frame
+  // but the last renders this grid, and the last one `grid` with this as the previous frame's
+  // volume (an animated grid under a still camera: the history's target is another volume's).
+  openvdb::FloatGrid::Ptr previousGrid;
 };
 
 struct ExtremeSize {
@@ -62,7 +66,7 @@ EstimatorRun runPtCase(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const E
 EstimatorRun runRestirCase(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const ExtremeCase& c, int runs,
                            uint32_t mis);
 // The same with any options (each run framesPerRun frames of the still scene from a reset
-// history, the last one measured).
+// history, the last one measured; ExtremeCase::previousGrid for an animated grid).
 EstimatorRun runRestirCase(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const ExtremeCase& c, int runs,
                            const RestirOptions& options, int framesPerRun = 1);
 

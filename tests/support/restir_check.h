@@ -38,19 +38,21 @@ inline RestirOptions spatialReuse(uint32_t mis) {
 // ReSTIR (pairwise and GBH, or only `misKinds`; `runs` independent runs each)
 // against one reference of refSpp, with `base` (one spatial round by default;
 // its prefix, shift and neighbour choice kept, its MIS kind replaced by each
-// of misKinds), each run the last of framesPerRun frames of a still camera.
+// of misKinds), each run the last of framesPerRun frames of a still camera (with
+// previousGrid: the frames before the last render that grid, ExtremeCase::previousGrid).
 inline void expectRestirMatchesReference(
     gpu::Context &ctx, gpu::ShaderCompiler &compiler, const Scene &s,
     openvdb::FloatGrid::Ptr grid, int runs, int refSpp, const std::string &name,
     std::vector<uint32_t> misKinds = {shared::RS_MIS_PAIRWISE,
                                       shared::RS_MIS_GBH},
     const RestirOptions &base = spatialReuse(shared::RS_MIS_PAIRWISE),
-    int framesPerRun = 1) {
+    int framesPerRun = 1, openvdb::FloatGrid::Ptr previousGrid = nullptr) {
   const Image ref = restirCheckReference(s, grid, refSpp);
   ExtremeCase c;
   c.name = name;
   c.scene = s;
   c.grid = grid;
+  c.previousGrid = previousGrid;
   for (const uint32_t mis : misKinds) {
     const std::string label =
         name + (mis == shared::RS_MIS_GBH ? "_gbh" : "_pairwise") + (base.reconnect ? "" : "_copy");
