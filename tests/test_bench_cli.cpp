@@ -151,6 +151,36 @@ TEST(BenchCli, WarmUpDefaultsToTheFramesTheHistoryNeedsToFill) {
   }
 }
 
+// --seed: the methods' random numbers (the same seed, the same errors; another, other errors),
+// never the cached converged image's; the table's header names it.
+TEST(BenchCli, SeedChangesTheMethodsNumbersNotTheReference) {
+  const fs::path dir = test::outputDir("bench_cli_seed");
+  const fs::path sceneDir = dir / "scene";
+  copySmokeScene(sceneDir);
+  auto run = [&](const char* seed) {
+    test::RunResult r = test::runPlume({"bench", (sceneDir / "smoke.json").string(), "-o", (dir / "out").string(),
+                                        "--width", "8", "--height", "8", "--ref-spp", "64", "--warmup", "1",
+                                        "--measure", "1", "--pt-spp", "1", "--no-cpu-ref", "--camera", "static",
+                                        "--only", "R0", "--seed", seed});
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(readText(dir / "out" / "smoke_bench.md").find(std::string("Seed ") + seed + "."), std::string::npos);
+    std::vector<std::string> errors;  // relMSE of each row, as written
+    const auto rows = csvRows(readText(dir / "out" / "smoke_bench.csv"));
+    for (size_t i = 1; i < rows.size(); ++i) errors.push_back(rows[i].at(3));
+    return errors;
+  };
+  const std::vector<std::string> a = run("5");
+  const size_t refs = countRefs(sceneDir / "bench_cache");
+  EXPECT_EQ(refs, 1u);
+  ASSERT_EQ(a.size(), 2u);  // pt 1 spp, ReSTIR R0
+  EXPECT_EQ(run("5"), a);
+  const std::vector<std::string> b = run("6");
+  ASSERT_EQ(b.size(), 2u);
+  EXPECT_NE(b[0], a[0]);
+  EXPECT_NE(b[1], a[1]);
+  EXPECT_EQ(countRefs(sceneDir / "bench_cache"), refs);  // the converged image was reused
+}
+
 TEST(BenchCli, AnUnknownVariantIsABadInput) {
   test::RunResult r = test::runPlume({"bench", test::sourcePath("volumes/smoke/smoke.json"), "-o",
                                       test::outputDir("bench_cli_bad"), "--width", "8", "--height", "8", "--only",

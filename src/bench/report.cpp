@@ -80,12 +80,13 @@ std::string svgPlot(const std::vector<BenchRow>& rows, const std::string& title)
 }  // namespace
 
 void writeBenchReport(BenchResult& result, const Scene& scene, const BenchOptions& o, int first, const std::string& dir) {
-  std::string md = strf("Device: %s. Scene: %s, %dx%d, max_bounces %d, the grid of frame %d held still. Warm-up %d "
+  std::string md = strf("Device: %s. Scene: %s, %dx%d, max_bounces %d, the grid of frame %d held still. Seed %lld. Warm-up %d "
                         "frames, %d measured; medians. Converged image: GPU path tracer, %d spp (own relMSE <= %.2g). ms/frame: GPU "
                         "timestamps; the CPU reference's rows (`reference N spp`, its own seed): wall time, on the "
                         "host's cores.\n\n",
                         result.device.c_str(), scene.path.c_str(), scene.camera.width, scene.camera.height,
-                        scene.render.maxBounces, first, o.warmup, o.frames, o.refSpp, result.referenceRelMse);
+                        scene.render.maxBounces, first, (long long)scene.render.seed, o.warmup,
+                        o.frames, o.refSpp, result.referenceRelMse);
   md += "| camera | method | ms/frame | relMSE | PT relMSE at equal time | gain vs PT | per-pass ms |\n";
   md += "|---|---|---|---|---|---|---|\n";
   std::string csv = "camera,method,frame_ms,relmse,pt_relmse_equal_time,gain\n";
