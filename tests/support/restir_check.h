@@ -17,11 +17,12 @@ namespace plume::test {
 
 // The CPU reference of scene s at spp (seed 4242).
 inline Image restirCheckReference(Scene s, openvdb::FloatGrid::Ptr grid,
-                                  int spp) {
+                                  int spp, int frame = 1) {
   s.render.spp = spp;
   s.render.seed = 4242;
   ref::ReferenceOptions opt;
   opt.progress = false;
+  opt.frame = frame;
   return ref::renderReference(s, grid, opt);
 }
 
@@ -38,7 +39,7 @@ inline RestirOptions spatialReuse(uint32_t mis) {
 // ReSTIR (pairwise and GBH, or only `misKinds`; `runs` independent runs each)
 // against one reference of refSpp, with `base` (one spatial round by default;
 // its prefix, shift and neighbour choice kept, its MIS kind replaced by each
-// of misKinds), each run the last of framesPerRun frames of a still camera (with
+// of misKinds), each run the last of framesPerRun frames (frames 1.. of the scene's camera; with
 // previousGrid: the frames before the last render that grid, ExtremeCase::previousGrid).
 inline void expectRestirMatchesReference(
     gpu::Context &ctx, gpu::ShaderCompiler &compiler, const Scene &s,
@@ -47,7 +48,8 @@ inline void expectRestirMatchesReference(
                                       shared::RS_MIS_GBH},
     const RestirOptions &base = spatialReuse(shared::RS_MIS_PAIRWISE),
     int framesPerRun = 1, openvdb::FloatGrid::Ptr previousGrid = nullptr) {
-  const Image ref = restirCheckReference(s, grid, refSpp);
+  // A moving camera (s.camera.keys) is measured at the last frame's pose.
+  const Image ref = restirCheckReference(s, grid, refSpp, s.camera.keys.empty() ? 1 : framesPerRun);
   ExtremeCase c;
   c.name = name;
   c.scene = s;
