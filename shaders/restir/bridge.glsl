@@ -122,18 +122,6 @@ float rs_emitter_light_pdf(uint prim, vec3 o, float dist, float cosLight) {
   return lightChoice[frame.lightCount].probability * surf_emitter_pdf_at(prim, o) * dist * dist / cosLight;
 }
 
-// Lamps seen directly (camera rays on emitters, one-vertex paths) have a reservoir of their own
-// (restir/candidates.glsl rs_lamp_reservoir): RS_DIRECT_RAYS candidates stratified over a
-// RS_DIRECT_SIDE² grid of the pixel.
-const uint RS_DIRECT_SIDE = 4u;
-const uint RS_DIRECT_RAYS = RS_DIRECT_SIDE * RS_DIRECT_SIDE;
-
-// Ray i's sub-pixel position: a uniform point u of its cell of a side² grid of the pixel.
-vec2 rs_direct_uv(uint i, uint side, vec2 u) {
-  vec2 cell = vec2(float(i % side), float(i / side));
-  return min((cell + u) * (1.0f / float(side)), vec2(1.0f));
-}
-
 // The emission of a hit on triangle prim at distance t along w from the ray origin o of a vertex
 // whose direction sampling has density pdfDir there (vtx_at_pdf), with its MIS weight: the
 // direction-sampling part of an emitter's light.

@@ -53,6 +53,15 @@ RsPathHead rs_candidate_head(uint uv, float t1, uint j, uint kinds, uint light, 
 // sub-pixel position (u, v); its target p̂_v(u, v) = Le x the mean field's transmittance of
 // volume v along the ray to the first surface (0 where that is no emitter's front). Final
 // shading adds W Le T along the sample's ray (restir/shade.glsl).
+const uint RS_DIRECT_SIDE = 4u;
+const uint RS_DIRECT_RAYS = RS_DIRECT_SIDE * RS_DIRECT_SIDE;
+
+// Candidate i's sub-pixel position: a uniform point u of cell i of the RS_DIRECT_SIDE² grid.
+vec2 rs_direct_uv(uint i, vec2 u) {
+  vec2 cell = vec2(float(i % RS_DIRECT_SIDE), float(i / RS_DIRECT_SIDE));
+  return min((cell + u) * (1.0f / float(RS_DIRECT_SIDE)), vec2(1.0f));
+}
+
 float rs_lamp_target(RsDomain D, uint v, uint uv) {
   vec3 dir = rs_domain_dir(D, rs_unpack_uv(uv));
   BvhHit hit = bvh_closest(D.origin, dir, 0.0f, SURF_FAR);
@@ -74,7 +83,7 @@ void rs_lamp_reservoir(RsDomain D, uint pixelIndex, inout RngState rng) {
   RsReservoir r = rs_empty();
   uint uv = 0u;
   for (uint i = 0u; i < RS_DIRECT_RAYS; ++i) {
-    uint c = rs_pack_uv(rs_direct_uv(i, RS_DIRECT_SIDE, rng_float2(rng)));
+    uint c = rs_pack_uv(rs_direct_uv(i, rng_float2(rng)));
     float ph = rs_lamp_target(D, VOL_CURRENT, c);
     if (rs_update(r, ph * (1.0f / float(RS_DIRECT_RAYS)), ph, 0.0f, rng_float(rng))) uv = c;
   }
