@@ -84,7 +84,9 @@ TEST_F(GpuRestirSurfaces, LampsSeenDirectlyMatchReference) {
 // ground. (Session 16: no such test existed; the city's moving-camera fireflies, notes/city.md,
 // made the question. It passes: worst pixel |z| <= 4.2, aggregate |z| <= 2. The worst pixel, at
 // the edge of the back-facing quad, reads z 3.9 with a still camera at the same pose too, and
-// failed at 4.9 against a 4096-spp reference whose value there was one rare path: hence 16384.)
+// failed at 4.9 against a 4096-spp reference whose value there was one rare path: hence 16384.
+// Can it fail: a temporal shift that took a surface primary vertex at its stored distance instead
+// of re-tracing it read mean ratio 0.45-0.83, notes/session-16-primary-shift-prototype.diff.)
 TEST_F(GpuRestirSurfaces, MovingCameraMatchesReferenceOfItsLastPose) {
   RestirOptions o = test::spatialReuse(shared::RS_MIS_PAIRWISE);
   o.historyCap = 20;
