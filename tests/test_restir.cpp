@@ -254,10 +254,46 @@ TEST_F(GpuRestir, MovingCameraMatchesReferencesOfItsPoses) {
   auto grid = test::makeNoiseGrid(40, 1.0 / 20, 2);
   RestirOptions o;
   o.radius = 6;
+  o.historyCapMoving = 5;  // as the bundled city (GpuRestirSurfaces' moving test keeps c 20)
   RunSpec spec;
   spec.framesPerRun = 4;
   RestirRun run = runRestir(ctx(), compiler(), s, o, spec, [&](int) { return grid; });
   expectMatches(run, reference(s, grid, 512, 4), "temporal_moving");
+}
+
+// restir_history_cap_moving caps the history only in frames whose camera moved: with a still
+// camera the two caps give the same image to the bit, with a moving one different images (the
+// Z-test above runs with 20 still and 5 moving).
+TEST_F(GpuRestir, HistoryCapWhileMovingActsOnlyWhenTheCameraMoves) {
+  auto grid = test::makeNoiseGrid(40, 1.0 / 20, 2);
+  RestirOptions tight;
+  tight.radius = 6;
+  tight.historyCap = 20;
+  tight.historyCapMoving = 2;
+  RestirOptions loose = tight;
+  loose.historyCapMoving = 20;
+  RunSpec spec;
+  spec.runs = 2;
+  spec.framesPerRun = 3;
+  auto differingPixels = [&](const Scene& s) {
+    const Image a = runRestir(ctx(), compiler(), s, tight, spec, [&](int) { return grid; }).mean;
+    const Image b = runRestir(ctx(), compiler(), s, loose, spec, [&](int) { return grid; }).mean;
+    size_t differ = 0;
+    for (size_t i = 0; i + 2 < a.rgb.size(); i += 3) {
+      differ += a.rgb[i] != b.rgb[i] || a.rgb[i + 1] != b.rgb[i + 1] || a.rgb[i + 2] != b.rgb[i + 2] ? 1 : 0;
+    }
+    return differ;
+  };
+  Scene still = baseScene(16);
+  EXPECT_EQ(differingPixels(still), 0u) << "a still camera must keep restir_history_cap";
+  Scene moving = still;
+  CameraKey key;
+  key.frame = 3;
+  key.pose = still.camera.base;
+  key.pose.position = {1.3f, 1.3f, 3.5f};
+  moving.camera.keys.push_back(key);
+  EXPECT_GT(differingPixels(moving), moving.camera.width * moving.camera.height / 4u)
+      << "a moving camera's history must be capped by restir_history_cap_moving";
 }
 
 TEST_F(GpuRestir, AnimatedGridMatchesReferenceOfItsLastFrame) {

@@ -122,6 +122,7 @@ RenderSettings withRestir(RenderSettings rs, const RestirOptions& v) {
   rs.restirRadius = v.radius;
   rs.restirRounds = v.rounds;
   rs.restirHistoryCap = v.historyCap;
+  rs.restirHistoryCapMoving = v.historyCapMoving;
   rs.restirPrefix = v.prefix;
   rs.restirLightCandidates = v.lightCandidates;
   rs.restirShift = v.reconnect ? "reconnect" : "copy";

@@ -17,6 +17,7 @@ std::string RestirOptions::name() const {
   // The light candidates likewise.
   const std::string k = (prefix == RestirOptions{}.prefix ? "" : strf(" K%d", prefix)) +
                         (lightCandidates == RestirOptions{}.lightCandidates ? "" : strf(" L%d", lightCandidates)) +
+                        (historyCapMoving == RestirOptions{}.historyCapMoving ? "" : strf(" cm%d", historyCapMoving)) +
                         (reconnect ? "" : " copy") +
                         (fixedNeighbourX || fixedNeighbourY ? strf(" at(%d,%d)", fixedNeighbourX, fixedNeighbourY) : "");
   if (rounds == 0) return strf("restir %s M%d R0 c%d%s", kind, candidates, historyCap, k.c_str());
@@ -30,6 +31,7 @@ RestirOptions restirOptionsOf(const RenderSettings& rs) {
   o.radius = rs.restirRadius;
   o.rounds = rs.restirRounds;
   o.historyCap = rs.restirHistoryCap;
+  o.historyCapMoving = rs.restirHistoryCapMoving;
   o.mis = rs.restirMis == "gbh" ? shared::RS_MIS_GBH : shared::RS_MIS_PAIRWISE;
   o.prefix = rs.restirPrefix;
   o.lightCandidates = rs.restirLightCandidates;
@@ -209,7 +211,6 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   params_.pixelCount = uint32_t(pixels);
   // The scene's lights and, with emissive surfaces, one entry for a point on them.
   params_.lightCount = uint32_t(scene.lights.size()) + (surfaces_ && surfaces_->emitterCount() > 0 ? 1u : 0u);
-  params_.historyCap = float(options_.historyCap);
   params_.reprojectionDepth = 1.0f;
   const bool fixedNeighbour = options_.fixedNeighbourX != 0 || options_.fixedNeighbourY != 0;
   params_.neighbours = fixedNeighbour ? 1u : uint32_t(options_.neighbours);
@@ -248,12 +249,15 @@ void Restir::resetHistory() { hasHistory_ = false; }
 void Restir::fillFrame(int frame, uint32_t sequence, uint32_t key) {
   frame_ = gpuFrame(scene_, frame, uint32_t(scene_.render.seed) + 0x9E3779B9u * sequence, key);
   const shared::GpuCamera& cam = frame_.camera;
-  const bool history = hasHistory_ && options_.historyCap > 0 && prevSequence_ == sequence;
+  const bool still = sameCamera(prevCam_, cam);
+  // The cap depends on the cameras only, never on a sample, so either value keeps reuse unbiased.
+  const int cap = still ? options_.historyCap : std::min(options_.historyCap, options_.historyCapMoving);
+  params_.historyCap = float(cap);
+  const bool history = hasHistory_ && cap > 0 && prevSequence_ == sequence;
   if (history) params_.prevCamera = prevCam_;
   params_.historyValid = history ? 1u : 0u;
   // The history's domain is the current one (a still camera over the grid it was rendered with):
   // the temporal shift is the identity and both cross-domain targets are the stored ones.
-  const bool still = sameCamera(prevCam_, cam);
   const bool sameVolume = previousSerial_ == currentSerial_ && renderedSerial_ == currentSerial_;
   params_.historySameDomain = history && still && sameVolume ? 1u : 0u;
   // The lamps seen directly (restir/candidates.glsl rs_lamp_reservoir): the sets alternate; the
