@@ -296,6 +296,59 @@ TEST_F(GpuRestir, HistoryCapWhileMovingActsOnlyWhenTheCameraMoves) {
       << "a moving camera's history must be capped by restir_history_cap_moving";
 }
 
+// restir_candidates_moving sets M only in frames whose camera moved since the previous frame:
+// with a still camera the scene's M applies (the same image to the bit as without the setting),
+// with a moving one the images differ. Unbiasedness with it is the Z-test below.
+TEST_F(GpuRestir, CandidatesWhileMovingActOnlyWhenTheCameraMoves) {
+  auto grid = test::makeNoiseGrid(40, 1.0 / 20, 2);
+  RestirOptions more;
+  more.radius = 6;
+  more.candidatesMoving = 8;
+  RestirOptions plain = more;
+  plain.candidatesMoving = 0;
+  RunSpec spec;
+  spec.runs = 2;
+  spec.framesPerRun = 3;
+  auto differingPixels = [&](const Scene& s) {
+    const Image a = runRestir(ctx(), compiler(), s, more, spec, [&](int) { return grid; }).mean;
+    const Image b = runRestir(ctx(), compiler(), s, plain, spec, [&](int) { return grid; }).mean;
+    size_t differ = 0;
+    for (size_t i = 0; i + 2 < a.rgb.size(); i += 3) {
+      differ += a.rgb[i] != b.rgb[i] || a.rgb[i + 1] != b.rgb[i + 1] || a.rgb[i + 2] != b.rgb[i + 2] ? 1 : 0;
+    }
+    return differ;
+  };
+  Scene still = baseScene(16);
+  EXPECT_EQ(differingPixels(still), 0u) << "a still camera must keep restir_candidates";
+  Scene moving = still;
+  CameraKey key;
+  key.frame = 3;
+  key.pose = still.camera.base;
+  key.pose.position = {1.3f, 1.3f, 3.5f};
+  moving.camera.keys.push_back(key);
+  EXPECT_GT(differingPixels(moving), moving.camera.width * moving.camera.height / 4u)
+      << "a moving camera's frames must use restir_candidates_moving";
+}
+
+// With more candidates while moving, ReSTIR still converges to the reference of its last pose.
+TEST_F(GpuRestir, CandidatesWhileMovingMatchReferenceOfTheLastPose) {
+  Scene s = baseScene(16);
+  CameraKey key;
+  key.frame = 4;
+  key.pose = s.camera.base;
+  key.pose.position = {1.6f, 1.3f, 3.4f};
+  s.camera.keys.push_back(key);
+  auto grid = test::makeNoiseGrid(40, 1.0 / 20, 2);
+  RestirOptions o;
+  o.radius = 6;
+  o.historyCapMoving = 5;
+  o.candidatesMoving = 8;  // moving frames M 8, still ones M 4 (the defaults' M)
+  RunSpec spec;
+  spec.framesPerRun = 4;
+  RestirRun run = runRestir(ctx(), compiler(), s, o, spec, [&](int) { return grid; });
+  expectMatches(run, reference(s, grid, 512, 4), "temporal_moving_m8");
+}
+
 TEST_F(GpuRestir, AnimatedGridMatchesReferenceOfItsLastFrame) {
   Scene s = baseScene(16);
   auto gridAt = [](int frame) { return test::makeNoiseGrid(40, 1.0 / 20, unsigned(10 + frame)); };

@@ -118,6 +118,7 @@ RenderSettings withRestir(RenderSettings rs, const RestirOptions& v) {
   rs.mode = v.mis == shared::RS_MIS_BIASED ? "restir-biased" : "restir";
   rs.restirMis = v.mis == shared::RS_MIS_GBH ? "gbh" : "pairwise";
   rs.restirCandidates = v.candidates;
+  rs.restirCandidatesMoving = v.candidatesMoving;
   rs.restirNeighbours = v.neighbours;
   rs.restirRadius = v.radius;
   rs.restirRounds = v.rounds;

@@ -18,6 +18,7 @@ std::string RestirOptions::name() const {
   const std::string k = (prefix == RestirOptions{}.prefix ? "" : strf(" K%d", prefix)) +
                         (lightCandidates == RestirOptions{}.lightCandidates ? "" : strf(" L%d", lightCandidates)) +
                         (historyCapMoving == RestirOptions{}.historyCapMoving ? "" : strf(" cm%d", historyCapMoving)) +
+                        (candidatesMoving == RestirOptions{}.candidatesMoving ? "" : strf(" Mm%d", candidatesMoving)) +
                         (reconnect ? "" : " copy") +
                         (fixedNeighbourX || fixedNeighbourY ? strf(" at(%d,%d)", fixedNeighbourX, fixedNeighbourY) : "");
   if (rounds == 0) return strf("restir %s M%d R0 c%d%s", kind, candidates, historyCap, k.c_str());
@@ -27,6 +28,7 @@ std::string RestirOptions::name() const {
 RestirOptions restirOptionsOf(const RenderSettings& rs) {
   RestirOptions o;
   o.candidates = rs.restirCandidates;
+  o.candidatesMoving = rs.restirCandidatesMoving;
   o.neighbours = rs.restirNeighbours;
   o.radius = rs.restirRadius;
   o.rounds = rs.restirRounds;
@@ -253,6 +255,10 @@ void Restir::fillFrame(int frame, uint32_t sequence, uint32_t key) {
   // The cap depends on the cameras only, never on a sample, so either value keeps reuse unbiased.
   const int cap = still ? options_.historyCap : std::min(options_.historyCap, options_.historyCapMoving);
   params_.historyCap = float(cap);
+  // Likewise the candidates (a per-frame M is a constant of the canonical reservoir), in frames
+  // whose camera moved since the previous frame of the sequence (the first frame keeps M).
+  const bool moved = hasHistory_ && prevSequence_ == sequence && !still;
+  params_.candidates = uint32_t(moved && options_.candidatesMoving > 0 ? options_.candidatesMoving : options_.candidates);
   const bool history = hasHistory_ && cap > 0 && prevSequence_ == sequence;
   if (history) params_.prevCamera = prevCam_;
   params_.historyValid = history ? 1u : 0u;

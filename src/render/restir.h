@@ -30,6 +30,7 @@ namespace plume {
 
 struct RestirOptions {
   int candidates = 4;        // M
+  int candidatesMoving = 0;  // M while the camera moves (0: candidates)
   int neighbours = 3;        // k
   int radius = 16;           // px
   int rounds = 1;            // R (0: no spatial reuse)

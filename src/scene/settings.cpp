@@ -27,6 +27,11 @@ const std::vector<SettingDesc>& renderSettingsTable() {
        "8 bits on most GPUs; README \"The scene file\")",
        &RenderSettings::densityFilter, 0, 0, {"exact", "biased-hardware"}},
       {"restir_candidates", "ReSTIR: candidate paths M per pixel and frame", &RenderSettings::restirCandidates, 1, 64, {}},
+      {"restir_candidates_moving",
+       "ReSTIR: candidate paths per pixel in frames whose camera moved (0 = restir_candidates). A moving "
+       "camera's history is shifted into the new pixels and where shifts fail the pixel's own candidates "
+       "carry it, so more of them can pay for their time there (notes/city.md \"Session 18\")",
+       &RenderSettings::restirCandidatesMoving, 0, 64, {}},
       {"restir_neighbours", "ReSTIR: spatial neighbours k per round", &RenderSettings::restirNeighbours, 1, 8, {}},
       {"restir_radius", "ReSTIR: spatial neighbour radius in pixels", &RenderSettings::restirRadius, 1, 256, {}},
       {"restir_rounds", "ReSTIR: spatial reuse rounds R (0 = no spatial reuse)", &RenderSettings::restirRounds, 0, 8, {}},

@@ -26,6 +26,7 @@ struct RenderSettings {
   std::string densityFilter = "exact";
   // Volumetric ReSTIR (DESIGN §4.2; src/render/restir.h)
   int restirCandidates = 4;          // M: candidate paths per pixel and frame
+  int restirCandidatesMoving = 0;    // ... in frames whose camera moved (0: restirCandidates)
   int restirNeighbours = 3;          // k: spatial neighbours per round
   int restirRadius = 16;             // spatial neighbour radius, pixels
   int restirRounds = 1;              // R: spatial rounds (0 = no spatial reuse)
