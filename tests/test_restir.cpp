@@ -261,73 +261,66 @@ TEST_F(GpuRestir, MovingCameraMatchesReferencesOfItsPoses) {
   expectMatches(run, reference(s, grid, 512, 4), "temporal_moving");
 }
 
+// Pixels whose value differs between the two options' mean images (two runs of three frames
+// over a noise cloud): under a still camera and under one that moves in the third frame.
+struct DifferingPixels {
+  size_t still;
+  size_t moving;
+  size_t pixels;
+};
+
+DifferingPixels differingPixels(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const RestirOptions& a,
+                                const RestirOptions& b) {
+  auto grid = test::makeNoiseGrid(40, 1.0 / 20, 2);
+  RunSpec spec;
+  spec.runs = 2;
+  spec.framesPerRun = 3;
+  auto differ = [&](const Scene& s) {
+    const Image x = runRestir(ctx, compiler, s, a, spec, [&](int) { return grid; }).mean;
+    const Image y = runRestir(ctx, compiler, s, b, spec, [&](int) { return grid; }).mean;
+    size_t n = 0;
+    for (size_t i = 0; i + 2 < x.rgb.size(); i += 3) {
+      n += x.rgb[i] != y.rgb[i] || x.rgb[i + 1] != y.rgb[i + 1] || x.rgb[i + 2] != y.rgb[i + 2] ? 1 : 0;
+    }
+    return n;
+  };
+  const Scene still = baseScene(16);
+  Scene moving = still;
+  CameraKey key;
+  key.frame = 3;
+  key.pose = still.camera.base;
+  key.pose.position = {1.3f, 1.3f, 3.5f};
+  moving.camera.keys.push_back(key);
+  return {differ(still), differ(moving), size_t(still.camera.width) * size_t(still.camera.height)};
+}
+
 // restir_history_cap_moving caps the history only in frames whose camera moved: with a still
 // camera the two caps give the same image to the bit, with a moving one different images (the
 // Z-test above runs with 20 still and 5 moving).
 TEST_F(GpuRestir, HistoryCapWhileMovingActsOnlyWhenTheCameraMoves) {
-  auto grid = test::makeNoiseGrid(40, 1.0 / 20, 2);
   RestirOptions tight;
   tight.radius = 6;
   tight.historyCap = 20;
   tight.historyCapMoving = 2;
   RestirOptions loose = tight;
   loose.historyCapMoving = 20;
-  RunSpec spec;
-  spec.runs = 2;
-  spec.framesPerRun = 3;
-  auto differingPixels = [&](const Scene& s) {
-    const Image a = runRestir(ctx(), compiler(), s, tight, spec, [&](int) { return grid; }).mean;
-    const Image b = runRestir(ctx(), compiler(), s, loose, spec, [&](int) { return grid; }).mean;
-    size_t differ = 0;
-    for (size_t i = 0; i + 2 < a.rgb.size(); i += 3) {
-      differ += a.rgb[i] != b.rgb[i] || a.rgb[i + 1] != b.rgb[i + 1] || a.rgb[i + 2] != b.rgb[i + 2] ? 1 : 0;
-    }
-    return differ;
-  };
-  Scene still = baseScene(16);
-  EXPECT_EQ(differingPixels(still), 0u) << "a still camera must keep restir_history_cap";
-  Scene moving = still;
-  CameraKey key;
-  key.frame = 3;
-  key.pose = still.camera.base;
-  key.pose.position = {1.3f, 1.3f, 3.5f};
-  moving.camera.keys.push_back(key);
-  EXPECT_GT(differingPixels(moving), moving.camera.width * moving.camera.height / 4u)
-      << "a moving camera's history must be capped by restir_history_cap_moving";
+  const DifferingPixels d = differingPixels(ctx(), compiler(), tight, loose);
+  EXPECT_EQ(d.still, 0u) << "a still camera must keep restir_history_cap";
+  EXPECT_GT(d.moving, d.pixels / 4u) << "a moving camera's history must be capped by restir_history_cap_moving";
 }
 
 // restir_candidates_moving sets M only in frames whose camera moved since the previous frame:
 // with a still camera the scene's M applies (the same image to the bit as without the setting),
 // with a moving one the images differ. Unbiasedness with it is the Z-test below.
 TEST_F(GpuRestir, CandidatesWhileMovingActOnlyWhenTheCameraMoves) {
-  auto grid = test::makeNoiseGrid(40, 1.0 / 20, 2);
   RestirOptions more;
   more.radius = 6;
   more.candidatesMoving = 8;
   RestirOptions plain = more;
   plain.candidatesMoving = 0;
-  RunSpec spec;
-  spec.runs = 2;
-  spec.framesPerRun = 3;
-  auto differingPixels = [&](const Scene& s) {
-    const Image a = runRestir(ctx(), compiler(), s, more, spec, [&](int) { return grid; }).mean;
-    const Image b = runRestir(ctx(), compiler(), s, plain, spec, [&](int) { return grid; }).mean;
-    size_t differ = 0;
-    for (size_t i = 0; i + 2 < a.rgb.size(); i += 3) {
-      differ += a.rgb[i] != b.rgb[i] || a.rgb[i + 1] != b.rgb[i + 1] || a.rgb[i + 2] != b.rgb[i + 2] ? 1 : 0;
-    }
-    return differ;
-  };
-  Scene still = baseScene(16);
-  EXPECT_EQ(differingPixels(still), 0u) << "a still camera must keep restir_candidates";
-  Scene moving = still;
-  CameraKey key;
-  key.frame = 3;
-  key.pose = still.camera.base;
-  key.pose.position = {1.3f, 1.3f, 3.5f};
-  moving.camera.keys.push_back(key);
-  EXPECT_GT(differingPixels(moving), moving.camera.width * moving.camera.height / 4u)
-      << "a moving camera's frames must use restir_candidates_moving";
+  const DifferingPixels d = differingPixels(ctx(), compiler(), more, plain);
+  EXPECT_EQ(d.still, 0u) << "a still camera must keep restir_candidates";
+  EXPECT_GT(d.moving, d.pixels / 4u) << "a moving camera's frames must use restir_candidates_moving";
 }
 
 // With more candidates while moving, ReSTIR still converges to the reference of its last pose.
