@@ -30,7 +30,8 @@ const std::vector<SettingDesc>& renderSettingsTable() {
       {"restir_candidates_moving",
        "ReSTIR: candidate paths per pixel in frames whose camera moved (0 = restir_candidates). A moving "
        "camera's history is shifted into the new pixels and where shifts fail the pixel's own candidates "
-       "carry it, so more of them can pay for their time there (notes/city.md \"Session 18\")",
+       "carry it: more of them lower a moving frame's error, on the bundled city about as much as they "
+       "cost in time (notes/city.md \"Session 18\")",
        &RenderSettings::restirCandidatesMoving, 0, 64, {}},
       {"restir_neighbours", "ReSTIR: spatial neighbours k per round", &RenderSettings::restirNeighbours, 1, 8, {}},
       {"restir_radius", "ReSTIR: spatial neighbour radius in pixels", &RenderSettings::restirRadius, 1, 256, {}},
