@@ -244,7 +244,10 @@ TEST_F(GpuRestir, ManyLightsChosenByPowerMatchReference) {
   expectMatches(run, reference(s, grid, 512), "many_lights");
 }
 
-TEST_F(GpuRestir, MovingCameraMatchesReferencesOfItsPoses) {
+// ReSTIR over four frames whose camera moves to a new pose by the last one, against the
+// reference of that pose.
+void expectMovingCameraMatches(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const RestirOptions& o,
+                               const char* label) {
   Scene s = baseScene(16);
   CameraKey key;
   key.frame = 4;
@@ -252,13 +255,17 @@ TEST_F(GpuRestir, MovingCameraMatchesReferencesOfItsPoses) {
   key.pose.position = {1.6f, 1.3f, 3.4f};
   s.camera.keys.push_back(key);
   auto grid = test::makeNoiseGrid(40, 1.0 / 20, 2);
+  RunSpec spec;
+  spec.framesPerRun = 4;
+  RestirRun run = runRestir(ctx, compiler, s, o, spec, [&](int) { return grid; });
+  expectMatches(run, reference(s, grid, 512, 4), label);
+}
+
+TEST_F(GpuRestir, MovingCameraMatchesReferencesOfItsPoses) {
   RestirOptions o;
   o.radius = 6;
   o.historyCapMoving = 5;  // as the bundled city (GpuRestirSurfaces' moving test keeps c 20)
-  RunSpec spec;
-  spec.framesPerRun = 4;
-  RestirRun run = runRestir(ctx(), compiler(), s, o, spec, [&](int) { return grid; });
-  expectMatches(run, reference(s, grid, 512, 4), "temporal_moving");
+  expectMovingCameraMatches(ctx(), compiler(), o, "temporal_moving");
 }
 
 // Pixels whose value differs between the two options' mean images (two runs of three frames
@@ -325,21 +332,11 @@ TEST_F(GpuRestir, CandidatesWhileMovingActOnlyWhenTheCameraMoves) {
 
 // With more candidates while moving, ReSTIR still converges to the reference of its last pose.
 TEST_F(GpuRestir, CandidatesWhileMovingMatchReferenceOfTheLastPose) {
-  Scene s = baseScene(16);
-  CameraKey key;
-  key.frame = 4;
-  key.pose = s.camera.base;
-  key.pose.position = {1.6f, 1.3f, 3.4f};
-  s.camera.keys.push_back(key);
-  auto grid = test::makeNoiseGrid(40, 1.0 / 20, 2);
   RestirOptions o;
   o.radius = 6;
   o.historyCapMoving = 5;
   o.candidatesMoving = 8;  // moving frames M 8, still ones M 4 (the defaults' M)
-  RunSpec spec;
-  spec.framesPerRun = 4;
-  RestirRun run = runRestir(ctx(), compiler(), s, o, spec, [&](int) { return grid; });
-  expectMatches(run, reference(s, grid, 512, 4), "temporal_moving_m8");
+  expectMovingCameraMatches(ctx(), compiler(), o, "temporal_moving_m8");
 }
 
 TEST_F(GpuRestir, AnimatedGridMatchesReferenceOfItsLastFrame) {
