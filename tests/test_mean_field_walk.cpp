@@ -104,7 +104,7 @@ void clip(const BakedVolume& vol, const Ray& r, double& t0, double& t1) {
 class MeanFieldWalk : public test::GpuTest {
  protected:
   struct Result {
-    float tau, t, sigma, unused;
+    float tau, t, sigma, depthMissed;  // depthMissed: vol_mean_sample's depth over the ray without a collision
   };
 
   std::vector<Result> run(const BakedVolume& bake, float scale, const std::vector<Ray>& rays) {
@@ -173,7 +173,7 @@ class MeanFieldWalk : public test::GpuTest {
   int expectWalksMatch(const BakedVolume& bake, float scale, int n, unsigned seed) {
     const std::vector<Ray> rays = makeRays(bake, n, seed);
     const std::vector<Result> res = run(bake, scale, rays);
-    int tauFail = 0, sampleFail = 0, hits = 0, exactHits = 0;
+    int tauFail = 0, sampleFail = 0, hits = 0, exactHits = 0, missedDepthFail = 0, misses = 0;
     double worstTau = 0.0, worstSample = 0.0;
     for (size_t i = 0; i < rays.size(); ++i) {
       const Ray& r = rays[i];
@@ -187,6 +187,14 @@ class MeanFieldWalk : public test::GpuTest {
         if (++tauFail <= 5) ADD_FAILURE() << "ray " << i << ": tau " << res[i].tau << ", CPU " << tau;
       }
       worstTau = std::max(worstTau, errTau);
+      // Without a collision, the sampling walk's depth over (0, tMax) is the depth walk's (the
+      // candidates use it for a surface's transmittance instead of marching the ray again).
+      if (res[i].t < 0.0f) {
+        ++misses;
+        if (std::abs(res[i].depthMissed - res[i].tau) > 1e-6f * res[i].tau) {
+          if (++missedDepthFail <= 5) ADD_FAILURE() << "ray " << i << ": depth without a collision " << res[i].depthMissed << ", depth walk " << res[i].tau;
+        }
+      }
       // The collision: hit exactly when the field's depth over the ray reaches -log(1 - u), at
       // the distance where it does, with the field's value there.
       const double target = -std::log(1.0 - double(r.u));
@@ -222,6 +230,8 @@ class MeanFieldWalk : public test::GpuTest {
                 scale, rays.size(), hits, exactHits, worstTau, worstSample, tauFail, sampleFail);
     EXPECT_EQ(tauFail, 0);
     EXPECT_EQ(sampleFail, 0);
+    EXPECT_EQ(missedDepthFail, 0) << "of " << misses << " rays without a collision";
+    EXPECT_GT(misses, n / 8);
     EXPECT_GT(hits, n / 8);
     return exactHits;
   }

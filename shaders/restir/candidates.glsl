@@ -177,7 +177,7 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
       PathVertex vx;
       if (!collided) {
         if (hit.prim == BVH_NONE) break;
-        float trSurface = exp(-min(vol_mean_tau(VOL_CURRENT, x, w, hit.t), VOL_MAX_TAU));
+        float trSurface = exp(-min(tau, VOL_MAX_TAU));  // tau: the mean field's depth to the surface
         t = hit.t;
         vec3 o = x;
         x += t * w;

@@ -30,5 +30,5 @@ void main() {
   float sigma;
   float tauHit;
   bool hit = vol_mean_sample(a.xyz, b.xyz, a.w, b.w, t, sigma, tauHit);
-  results[i] = vec4(tau, hit ? t : -1.0f, hit ? sigma : 0.0f, 0.0f);
+  results[i] = vec4(tau, hit ? t : -1.0f, hit ? sigma : 0.0f, hit ? 0.0f : tauHit);
 }

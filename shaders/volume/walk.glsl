@@ -145,6 +145,7 @@ struct VolTrack {
                 // SAMPLE: the optical depth still to go
   float t;      // DELTA, SAMPLE: the collision's distance (tMax without one)
   float sigma;  // SAMPLE: the mean field's sigma_t at the collision
+  float depth;  // SAMPLE: the optical depth crossed (without a collision: over (0, tMax))
   bool hit;     // DELTA, SAMPLE: a collision was found
   bool stop;    // the walk ends now (a hit, a transmittance ended by roulette, the step cap)
 #ifdef PLUME_HAS_EMISSION
@@ -203,6 +204,7 @@ float vol_track_segment(uint tracker, inout VolTrack s, float a, float b, vec2 v
     s.hit = true;
   } else {
     s.value -= dtau;
+    s.depth += dtau;
   }
   return 0.0f;
 }
@@ -273,6 +275,7 @@ float vol_track_exact(uint tracker, inout VolTrack s, VolWalk w, float scale, fl
     s.hit = true;
   } else {
     s.value -= total;
+    s.depth += total;
   }
   return 0.0f;
 }
@@ -553,6 +556,7 @@ VolTrack vol_track(uint tracker, uint v, vec3 xWorld, vec3 wWorld, float tMax, f
   s.value = init;
   s.t = tMax;
   s.sigma = 0.0f;
+  s.depth = 0.0f;
   s.hit = false;
   s.stop = false;
 #ifdef PLUME_HAS_EMISSION
@@ -641,13 +645,15 @@ float vol_mean_tr(uint v, vec3 xWorld, vec3 wWorld, float tMax) {
 // sigmaC * exp(-tau) in closed form. False (probability exp(-tau_c(0, tMax))) when the ray
 // leaves first. tau, the optical depth to the collision, is also the target's transmittance of
 // the segment, so a candidate marches each segment once (tau <= -log(2^-24) ~ 16.6: the pdf
-// never underflows).
+// never underflows). Without a collision tau is the optical depth over (0, tMax), the one
+// vol_mean_tau would march again (the same segments summed in the same order).
 bool vol_mean_sample(vec3 xWorld, vec3 wWorld, float tMax, float u, out float t, out float sigmaC, out float tau) {
   tau = -log(1.0f - u);
   RngState unused = RngState(uvec4(0u), 0u);  // never drawn from: SAMPLE is closed form
   VolTrack s = vol_track(VOL_TRACK_SAMPLE, VOL_CURRENT, xWorld, wWorld, tMax, tau, unused);
   t = s.t;
   sigmaC = s.sigma;
+  if (!s.hit) tau = s.depth;
   return s.hit;
 }
 
