@@ -150,9 +150,10 @@ GpuSurfaces::GpuSurfaces(gpu::Context& ctx, const Scene& scene) {
   materials_ = upload(ctx, materials, "surface materials");
   emitters_ = upload(ctx, lightTree.nodes, "light tree");
   uploadMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  logInfo(strf("surfaces: %zu triangles (%u emissive, light tree depth %d), BVH %zu nodes, %.1f bytes/triangle on the "
-               "device; built in %.0f ms",
-               mesh.triangleCount(), emitterCount_, lightTreeDepth_, stats_.nodes, stats_.bytesPerTriangle(), stats_.buildMs));
+  logInfo(strf("surfaces: %zu triangles (%u emissive, light tree depth %d), BVH %zu nodes, %d levels, %.1f "
+               "bytes/triangle on the device; built in %.0f ms",
+               mesh.triangleCount(), emitterCount_, lightTreeDepth_, stats_.nodes, stats_.depth, stats_.bytesPerTriangle(),
+               stats_.buildMs));
 }
 
 gpu::BindingTypes GpuSurfaces::bindingTypes(uint32_t shift) {
