@@ -9,6 +9,7 @@
 #include "geometry/mesh.h"
 #include "support/meshes.h"
 
+#include <cstring>
 #include <gtest/gtest.h>
 
 #include <vector>
@@ -73,7 +74,15 @@ std::vector<int> checkTree(const geo::TriangleMesh& mesh, const geo::FlatBvh& bv
   EXPECT_EQ(bvh.stats.leaves, leaves);
   EXPECT_EQ(bvh.stats.nodes, bvh.nodes.size());
   EXPECT_EQ(bvh.stats.references, bvh.triangles.size());
-  EXPECT_EQ(bvh.stats.bytes, bvh.nodes.size() * 64 + bvh.triangles.size() * 48);
+  // The device's texels (shared/bvh.h): a header, 4 per node, 3 per triangle, a zero texel; the
+  // header names triangle 0's texel, and the nodes and triangles are their structs' bytes.
+  const std::vector<glm::uvec4> texels = geo::bvhDeviceTexels(bvh);
+  EXPECT_EQ(bvh.stats.bytes, 16 + bvh.nodes.size() * 64 + bvh.triangles.size() * 48 + 16);
+  EXPECT_EQ(texels.size() * 16, bvh.stats.bytes);
+  EXPECT_EQ(texels[0].x, 1 + 4 * bvh.nodes.size());
+  EXPECT_EQ(std::memcmp(&texels[1], bvh.nodes.data(), bvh.nodes.size() * 64), 0);
+  if (!bvh.triangles.empty()) EXPECT_EQ(std::memcmp(&texels[texels[0].x], bvh.triangles.data(), bvh.triangles.size() * 48), 0);
+  EXPECT_EQ(texels.back(), glm::uvec4(0u));
   return refs;
 }
 

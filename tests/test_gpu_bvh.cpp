@@ -202,21 +202,18 @@ class GpuBvh : public test::GpuTest {
   std::vector<RayResult> trace(const geo::FlatBvh& bvh, const std::vector<RayCase>& rays) {
     using gpu::BindingType;
     gpu::ComputePass pass(ctx(), compiler().compile("tests/bvh_kernels.comp", {}),
-                          {BindingType::TexelBuffer, BindingType::TexelBuffer, BindingType::StorageBuffer, BindingType::StorageBuffer},
+                          {BindingType::TexelBuffer, BindingType::StorageBuffer, BindingType::StorageBuffer},
                           4, "bvh kernels", glm::uvec3(64, 1, 1));
     const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-    // As render/gpu_surfaces.cpp uploads them: each struct's bytes as 16-byte texels.
-    gpu::TexelBuffer nodes(ctx(), bvh.nodes.data(), bvh.nodes.size() * sizeof(sh::BvhNode) / 16,
-                           VK_FORMAT_R32G32B32A32_UINT, "bvh nodes");
-    gpu::TexelBuffer tris(ctx(), bvh.triangles.empty() ? nullptr : bvh.triangles.data(),
-                          bvh.triangles.size() * sizeof(sh::BvhTriangle) / 16, VK_FORMAT_R32G32B32A32_UINT, "bvh triangles");
+    // As render/gpu_surfaces.cpp uploads it: one texel buffer (shared/bvh.h, "On the device").
+    const std::vector<glm::uvec4> texels = geo::bvhDeviceTexels(bvh);
+    gpu::TexelBuffer tree(ctx(), texels.data(), texels.size(), VK_FORMAT_R32G32B32A32_UINT, "bvh");
     gpu::Buffer in(ctx(), rays.size() * sizeof(RayCase), storage, "rays");
     gpu::Buffer out(ctx(), rays.size() * sizeof(RayResult), storage, "results");
     in.upload(rays.data(), rays.size() * sizeof(RayCase));
-    pass.set.bind(0, nodes);
-    pass.set.bind(1, tris);
-    pass.set.bind(2, in);
-    pass.set.bind(3, out);
+    pass.set.bind(0, tree);
+    pass.set.bind(1, in);
+    pass.set.bind(2, out);
     const uint32_t count = uint32_t(rays.size());
     const auto t0 = std::chrono::steady_clock::now();
     ctx().submitAndWait([&](VkCommandBuffer cmd) { pass.record(cmd, glm::uvec3(count, 1, 1), &count); });

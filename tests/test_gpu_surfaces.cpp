@@ -119,9 +119,9 @@ TEST_F(GpuSurfaceTest, ASceneWithoutSurfacesCompilesNoTraversal) {
   EXPECT_FALSE(featuresOf(without).surfaces);
   EXPECT_TRUE(featuresOf(with).surfaces);
   for (const char* kernel : {"passes/pt_extend.comp", "passes/pt_shade.comp"}) {
-    EXPECT_FALSE(declaresBinding(compiler().compile(kernel, featuresOf(without).defines()), shared::BIND_BVH_NODES))
+    EXPECT_FALSE(declaresBinding(compiler().compile(kernel, featuresOf(without).defines()), shared::BIND_BVH))
         << kernel;
-    EXPECT_TRUE(declaresBinding(compiler().compile(kernel, featuresOf(with).defines()), shared::BIND_BVH_NODES))
+    EXPECT_TRUE(declaresBinding(compiler().compile(kernel, featuresOf(with).defines()), shared::BIND_BVH))
         << kernel;
   }
   EXPECT_FALSE(PathTracer(ctx(), compiler(), without).hasSurfaces());

@@ -27,11 +27,10 @@ const uint BIND_PT_WAVE = 10u;         // PtWave: queue lengths and the indirect
 
 // The scene's surfaces (shaders/surface/surfaces.glsl; render/gpu_surfaces.cpp), in the
 // estimators that render them (PLUME_HAS_SURFACES).
-const uint BIND_BVH_NODES = 11u;       // BvhNode[]
-const uint BIND_BVH_TRIANGLES = 12u;   // BvhTriangle[]
-const uint BIND_SURF_TRIANGLES = 13u;  // GpuSurfaceTriangle[], by input index
-const uint BIND_SURF_MATERIALS = 14u;  // GpuSurfaceMaterial[], by surface
-const uint BIND_EMITTERS = 15u;        // GpuLightNode[]: the emissive triangles' light tree
+const uint BIND_BVH = 11u;             // the BVH's header, nodes and triangles (shared/bvh.h)
+const uint BIND_SURF_TRIANGLES = 12u;  // GpuSurfaceTriangle[], by input index
+const uint BIND_SURF_MATERIALS = 13u;  // GpuSurfaceMaterial[], by surface
+const uint BIND_EMITTERS = 14u;        // GpuLightNode[]: the emissive triangles' light tree
 
 // ReSTIR (shaders/restir/bindings.glsl): its parameters, the current volume's mean field, the
 // previous frame's volume (temporal reuse evaluates the history's target with it), reservoirs.
@@ -59,9 +58,9 @@ const uint BIND_BLACKBODY = 21u;       // vec4[]: the blackbody table (shared/bl
 const uint BIND_PREV_EMISSION_ATLAS = 22u;  // sampler3D: the previous frame's (ReSTIR's history)
 const uint EMISSION_BINDING_COUNT = 23u;  // binding tables that may hold the emission extend to it
 
-// ReSTIR's passes hold the surfaces' buffers (BIND_BVH_NODES .. BIND_EMITTERS) shifted by this
-// (PLUME_SURF_BINDING_SHIFT in surface/surfaces.glsl): 23 .. 27, past the emission's.
-const uint RS_SURF_BINDING_SHIFT = EMISSION_BINDING_COUNT - BIND_BVH_NODES;
+// ReSTIR's passes hold the surfaces' buffers (BIND_BVH .. BIND_EMITTERS) shifted by this
+// (PLUME_SURF_BINDING_SHIFT in surface/surfaces.glsl): 23 .. 26, past the emission's.
+const uint RS_SURF_BINDING_SHIFT = EMISSION_BINDING_COUNT - BIND_BVH;
 const uint RS_SURFACE_BINDING_COUNT = BIND_EMITTERS + RS_SURF_BINDING_SHIFT + 1u;
 
 PLUME_NS_END

@@ -20,6 +20,16 @@ const int BVH_MAX_DEPTH = 48;       // nodes on the longest root-to-leaf path, c
 const int BVH_STACK_SIZE = 48;      // traversal stack entries: at most one per level below the root
 const uint BVH_MAX_LEAF_SIZE = 4u;  // triangles per leaf
 
+// On the device the whole tree is one texel buffer of uvec4 (BIND_BVH; geo::bvhDeviceTexels):
+// texel 0 a header (x: the texel of triangle 0), then the nodes (BVH_NODE_TEXEL_COUNT each, node i
+// at 1 + 4 i), then the triangles (BVH_TRIANGLE_TEXEL_COUNT each), then one zero texel. Either kind
+// of item is then the same four reads (a triangle's fourth is the next one's first, or the zero
+// texel), so the traversal makes one set of reads per loop iteration where a SIMD back end paid
+// for a node's and a triangle's in every iteration (surface/bvh.glsl).
+const uint BVH_HEADER_TEXELS = 1u;
+const uint BVH_NODE_TEXEL_COUNT = 4u;
+const uint BVH_TRIANGLE_TEXEL_COUNT = 3u;
+
 // Child c of an inner node: count == 0: inner node `ref` (or nothing when ref == BVH_NONE);
 // count > 0: a leaf of `count` triangles starting at triangle `ref`.
 struct BvhNode {

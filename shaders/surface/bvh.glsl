@@ -1,6 +1,6 @@
 // Ray traversal of the surfaces' BVH (layout: shared/bvh.h; built by geometry/bvh.cpp): the
 // closest hit and any hit (shadow rays) over t in (tMin, tMax). The includer provides the
-// storage through BVH_NODE(i) (a BvhNode) and BVH_TRIANGLE(i) (a BvhTriangle).
+// storage, one texel buffer of uvec4 laid out as shared/bvh.h says, through BVH_TEXEL(i).
 //
 // Ray/triangle: the watertight test of Woop, Benthin and Wald 2013 ("Watertight Ray/Triangle
 // Intersection", JCGT 2(1)): the vertices are translated to the ray origin and sheared so that
@@ -17,7 +17,10 @@
 // iteration visits one node or tests one triangle (a leaf of n triangles stays the current item,
 // ref + 1 and n - 1, for n iterations): a SIMD back end runs the whole loop body on every
 // iteration (../shared/docs/LAVAPIPE.md), and a triangle loop nested in it ran at least once per
-// node visit of any lane (lavapipe: the city's path tracer 12 % faster without it, same hits).
+// node visit of any lane (lavapipe: the city's path tracer 12 % faster without it, same hits). For
+// the same reason an iteration reads its item, node or triangle, with one set of four texel reads
+// (the layout of shared/bvh.h) instead of a node's four and a triangle's three (the city's path
+// tracer another ~10 %).
 #ifndef PLUME_SURFACE_BVH_GLSL
 #define PLUME_SURFACE_BVH_GLSL
 
@@ -110,11 +113,17 @@ BvhHit bvh_traverse(BvhRay r, float tMin, float tMax, const bool anyHit) {
   uint stack[BVH_STACK_SIZE];
   int sp = 0;
   uint item = 0u;  // the root, an inner node
+  uint firstTriangle = BVH_TEXEL(0u).x;  // the header: triangle 0's texel
   while (true) {
     uint count = item & 7u;
     uint ref = item >> 3u;
+    uint at = count == 0u ? BVH_HEADER_TEXELS + BVH_NODE_TEXEL_COUNT * ref : firstTriangle + BVH_TRIANGLE_TEXEL_COUNT * ref;
+    uvec4 q0 = BVH_TEXEL(at);
+    uvec4 q1 = BVH_TEXEL(at + 1u);
+    uvec4 q2 = BVH_TEXEL(at + 2u);
+    uvec4 q3 = BVH_TEXEL(at + 3u);
     if (count == 0u) {
-      BvhNode node = BVH_NODE(ref);
+      BvhNode node = bvh_node_from(q0, q1, q2, q3);
       float d0 = node.ref0 == BVH_NONE ? BVH_BIG : bvh_box(r, node.lo0, node.hi0, tMin, hit.t);
       float d1 = node.ref1 == BVH_NONE ? BVH_BIG : bvh_box(r, node.lo1, node.hi1, tMin, hit.t);
       uint c0 = (node.ref0 << 3u) | node.count0;
@@ -130,7 +139,7 @@ BvhHit bvh_traverse(BvhRay r, float tMin, float tMax, const bool anyHit) {
         continue;
       }
     } else {
-      BvhTriangle tri = BVH_TRIANGLE(ref);
+      BvhTriangle tri = bvh_triangle_from(q0, q1, q2);
       float t;
       vec2 uv;
       if (bvh_triangle(r, tri, tMin, hit.t, t, uv)) {

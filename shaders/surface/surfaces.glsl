@@ -14,16 +14,14 @@
 #include "../shared/light_tree.h"
 
 // The estimator's binding numbers may be shifted as a block (ReSTIR's passes use 11-15 for their
-// own buffers: shared/bindings.h BIND_RS_SURFACES); the path tracer's are BIND_BVH_NODES ...
+// own buffers: shared/bindings.h BIND_RS_SURFACES); the path tracer's are BIND_BVH ...
 #ifndef PLUME_SURF_BINDING_SHIFT
 #define PLUME_SURF_BINDING_SHIFT 0u
 #endif
 // Every array is a texel buffer of uvec4 (surface/texels.glsl says why).
 #include "texels.glsl"
-layout(binding = BIND_BVH_NODES + PLUME_SURF_BINDING_SHIFT) uniform usamplerBuffer bvhNodeTexels;
-layout(binding = BIND_BVH_TRIANGLES + PLUME_SURF_BINDING_SHIFT) uniform usamplerBuffer bvhTriangleTexels;
-#define BVH_NODE(i) BVH_NODE_TEXELS(bvhNodeTexels, i)
-#define BVH_TRIANGLE(i) BVH_TRIANGLE_TEXELS(bvhTriangleTexels, i)
+layout(binding = BIND_BVH + PLUME_SURF_BINDING_SHIFT) uniform usamplerBuffer bvhTexels;
+#define BVH_TEXEL(i) SURF_TEXEL(bvhTexels, i)
 #include "bvh.glsl"
 
 layout(binding = BIND_SURF_TRIANGLES + PLUME_SURF_BINDING_SHIFT) uniform usamplerBuffer surfTriangleTexels;

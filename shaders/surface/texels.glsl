@@ -24,9 +24,6 @@ BvhNode bvh_node_from(uvec4 a, uvec4 b, uvec4 c, uvec4 d) {
   n.count1 = d.w;
   return n;
 }
-#define BVH_NODE_TEXELS(buf, i) \
-  bvh_node_from(SURF_TEXEL(buf, 4u * (i)), SURF_TEXEL(buf, 4u * (i) + 1u), SURF_TEXEL(buf, 4u * (i) + 2u), \
-                SURF_TEXEL(buf, 4u * (i) + 3u))
 
 BvhTriangle bvh_triangle_from(uvec4 a, uvec4 b, uvec4 c) {
   BvhTriangle t;
@@ -38,7 +35,5 @@ BvhTriangle bvh_triangle_from(uvec4 a, uvec4 b, uvec4 c) {
   t.pad1 = c.w;
   return t;
 }
-#define BVH_TRIANGLE_TEXELS(buf, i) \
-  bvh_triangle_from(SURF_TEXEL(buf, 3u * (i)), SURF_TEXEL(buf, 3u * (i) + 1u), SURF_TEXEL(buf, 3u * (i) + 2u))
 
 #endif

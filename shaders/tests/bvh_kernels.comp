@@ -7,12 +7,10 @@ layout(local_size_x = 64) in;
 
 #include "../shared/bvh.h"
 
-// The nodes and triangles as texel buffers of uvec4, read as surface/surfaces.glsl reads them.
+// The tree as one texel buffer of uvec4 (shared/bvh.h), read as surface/surfaces.glsl reads it.
 #include "../surface/texels.glsl"
-layout(binding = 0) uniform usamplerBuffer bvhNodeTexels;
-layout(binding = 1) uniform usamplerBuffer bvhTriangleTexels;
-#define BVH_NODE(i) BVH_NODE_TEXELS(bvhNodeTexels, i)
-#define BVH_TRIANGLE(i) BVH_TRIANGLE_TEXELS(bvhTriangleTexels, i)
+layout(binding = 0) uniform usamplerBuffer bvhTexels;
+#define BVH_TEXEL(i) SURF_TEXEL(bvhTexels, i)
 #include "../surface/bvh.glsl"
 
 struct RayCase {
@@ -24,8 +22,8 @@ struct RayResult {
   BvhHit closest;
   BvhHit any;  // the any-hit traversal's hit (prim BVH_NONE: none), as bvh_any sees it
 };
-layout(std430, binding = 2) readonly buffer Cases { RayCase cases[]; };
-layout(std430, binding = 3) writeonly buffer Results { RayResult results[]; };
+layout(std430, binding = 1) readonly buffer Cases { RayCase cases[]; };
+layout(std430, binding = 2) writeonly buffer Results { RayResult results[]; };
 layout(push_constant) uniform Push { uint count; } pc;
 
 void main() {

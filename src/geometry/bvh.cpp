@@ -13,6 +13,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <mutex>
 #include <string>
@@ -227,6 +228,17 @@ double msSince(std::chrono::steady_clock::time_point t0) {
 
 }  // namespace
 
+std::vector<glm::uvec4> bvhDeviceTexels(const FlatBvh& bvh) {
+  static_assert(sizeof(shared::BvhNode) == 16 * shared::BVH_NODE_TEXEL_COUNT, "BvhNode: 4 texels");
+  static_assert(sizeof(shared::BvhTriangle) == 16 * shared::BVH_TRIANGLE_TEXEL_COUNT, "BvhTriangle: 3 texels");
+  const size_t first = shared::BVH_HEADER_TEXELS + bvh.nodes.size() * shared::BVH_NODE_TEXEL_COUNT;
+  std::vector<glm::uvec4> texels(first + bvh.triangles.size() * shared::BVH_TRIANGLE_TEXEL_COUNT + 1, glm::uvec4(0u));
+  texels[0].x = uint32_t(first);
+  if (!bvh.nodes.empty()) std::memcpy(&texels[shared::BVH_HEADER_TEXELS], bvh.nodes.data(), bvh.nodes.size() * sizeof(shared::BvhNode));
+  if (!bvh.triangles.empty()) std::memcpy(&texels[first], bvh.triangles.data(), bvh.triangles.size() * sizeof(shared::BvhTriangle));
+  return texels;
+}
+
 FlatBvh buildBvh(const TriangleMesh& mesh, const BvhOptions& options) {
   FlatBvh out;
   out.stats.inputTriangles = mesh.triangles.size();
@@ -292,7 +304,8 @@ FlatBvh buildBvh(const TriangleMesh& mesh, const BvhOptions& options) {
   out.stats.buildMs += msSince(t2);
   out.stats.nodes = out.nodes.size();
   out.stats.references = out.triangles.size();
-  out.stats.bytes = out.nodes.size() * sizeof(sh::BvhNode) + out.triangles.size() * sizeof(sh::BvhTriangle);
+  out.stats.bytes = 16 * (sh::BVH_HEADER_TEXELS + 1) + out.nodes.size() * sizeof(sh::BvhNode) +
+                    out.triangles.size() * sizeof(sh::BvhTriangle);  // bvhDeviceTexels
   // The traversal packs a child reference with its count in one word (ref << 3 | count).
   if (out.triangles.size() >= (size_t(1) << 29) || out.nodes.size() >= (size_t(1) << 29))
     throw InputError("the surfaces hold " + std::to_string(out.triangles.size()) + " triangle references, more than the 2^29 the BVH layout addresses");

@@ -20,7 +20,7 @@ struct BvhStats {
   int depth = 0;          // inner nodes on the longest root-to-leaf path
   double buildMs = 0.0;   // Embree's build
   double flattenMs = 0.0;
-  size_t bytes = 0;       // nodes + triangles on the device
+  size_t bytes = 0;       // the device's texels: header, nodes, triangles, padding
   double bytesPerTriangle() const { return inputTriangles ? double(bytes) / double(inputTriangles) : 0.0; }
 };
 
@@ -42,6 +42,10 @@ struct BvhOptions {
 // is deeper than the shader's traversal stack or holds 2^29 or more triangle references,
 // InternalError or DeviceError when Embree fails.
 FlatBvh buildBvh(const TriangleMesh& mesh, const BvhOptions& options = {});
+
+// The tree as the shaders read it: one array of 16-byte texels, the header, the nodes, the
+// triangles and a zero texel (shared/bvh.h, "On the device").
+std::vector<glm::uvec4> bvhDeviceTexels(const FlatBvh& bvh);
 
 // An Embree scene of one triangle mesh (primID = triangle index), built with
 // RTC_BUILD_QUALITY_HIGH and RTC_SCENE_FLAG_ROBUST (watertight intersection).

@@ -144,8 +144,7 @@ GpuSurfaces::GpuSurfaces(gpu::Context& ctx, const Scene& scene) {
   emitterCount_ = uint32_t(emitters.size());
   lightTreeDepth_ = lightTree.depth;
 
-  nodes_ = upload(ctx, bvh.nodes, "BVH nodes");
-  bvhTriangles_ = upload(ctx, bvh.triangles, "BVH triangles");
+  bvh_ = upload(ctx, geo::bvhDeviceTexels(bvh), "BVH");
   triangles_ = upload(ctx, triangles, "surface triangles");
   materials_ = upload(ctx, materials, "surface materials");
   emitters_ = upload(ctx, lightTree.nodes, "light tree");
@@ -158,15 +157,14 @@ GpuSurfaces::GpuSurfaces(gpu::Context& ctx, const Scene& scene) {
 
 gpu::BindingTypes GpuSurfaces::bindingTypes(uint32_t shift) {
   gpu::BindingTypes t;
-  for (uint32_t b = shared::BIND_BVH_NODES; b <= shared::BIND_EMITTERS; ++b) {
+  for (uint32_t b = shared::BIND_BVH; b <= shared::BIND_EMITTERS; ++b) {
     t.push_back({b + shift, gpu::BindingType::TexelBuffer});
   }
   return t;
 }
 
 void GpuSurfaces::bind(gpu::DescriptorSet& set, uint32_t shift) const {
-  set.bind(shared::BIND_BVH_NODES + shift, nodes_);
-  set.bind(shared::BIND_BVH_TRIANGLES + shift, bvhTriangles_);
+  set.bind(shared::BIND_BVH + shift, bvh_);
   set.bind(shared::BIND_SURF_TRIANGLES + shift, triangles_);
   set.bind(shared::BIND_SURF_MATERIALS + shift, materials_);
   set.bind(shared::BIND_EMITTERS + shift, emitters_);

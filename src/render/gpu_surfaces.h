@@ -38,7 +38,7 @@ class GpuSurfaces {
   // larger than the device's texel buffers allow (the message names the buffer).
   GpuSurfaces(gpu::Context& ctx, const Scene& scene);
 
-  // Binds BIND_BVH_NODES .. BIND_EMITTERS, each shifted by `shift` (surface/surfaces.glsl
+  // Binds BIND_BVH .. BIND_EMITTERS, each shifted by `shift` (surface/surfaces.glsl
   // PLUME_SURF_BINDING_SHIFT).
   void bind(gpu::DescriptorSet& set, uint32_t shift = 0) const;
   // Their descriptor types: uniform texel buffers of uvec4 (surface/texels.glsl).
@@ -51,7 +51,7 @@ class GpuSurfaces {
   double uploadMs() const { return uploadMs_; }
 
  private:
-  gpu::TexelBuffer nodes_, bvhTriangles_, triangles_, materials_, emitters_;
+  gpu::TexelBuffer bvh_, triangles_, materials_, emitters_;
   uint32_t emitterCount_ = 0;
   int lightTreeDepth_ = 0;
   struct EmitterSummary {
