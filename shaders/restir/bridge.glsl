@@ -187,14 +187,19 @@ bool rs_light_connect(PathVertex vx, uint light, vec2 ls, uint prim, bool withMi
 }
 
 // The light term at the path's last vertex vx: the connection's unshadowed term times the
-// transmittance along the light ray (and, with surfaces, its visibility).
+// transmittance along the light ray (and, with surfaces, its visibility). The target's light ray
+// takes the mean field's depth by the midpoint rule (vol_mean_tau_midpoints: far cheaper than the
+// voxel walk of the path's own segments, which the candidates' sampling needs exactly); final
+// shading's is unbiased (rs_transmittance).
 vec3 rs_light_term(uint v, PathVertex vx, uint light, vec2 ls, uint prim, bool unbiased, inout RngState rng) {
   RsLightRay c;
   if (!rs_light_connect(vx, light, ls, prim, true, c)) return vec3(0.0f);
 #ifdef PLUME_HAS_SURFACES
   if (surf_occluded(c.o, c.w, c.reach)) return vec3(0.0f);
 #endif
-  return c.value * rs_transmittance(v, c.o, c.w, c.reach, unbiased, rng);
+  float tr = unbiased ? rs_transmittance(v, c.o, c.w, c.reach, true, rng)
+                      : exp(-min(vol_mean_tau_midpoints(v, c.o, c.w, c.reach), VOL_MAX_TAU));
+  return c.value * tr;
 }
 
 // A candidate vertex's light sample by resampled importance sampling (Talbot et al. 2005; the
