@@ -20,7 +20,7 @@
 // node visit of any lane (lavapipe: the city's path tracer 12 % faster without it, same hits). For
 // the same reason an iteration reads its item, node or triangle, with one set of four texel reads
 // (the layout of shared/bvh.h) instead of a node's four and a triangle's three (the city's path
-// tracer another ~10 %).
+// tracer another 5-8 %).
 #ifndef PLUME_SURFACE_BVH_GLSL
 #define PLUME_SURFACE_BVH_GLSL
 
