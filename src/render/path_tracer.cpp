@@ -29,7 +29,10 @@ PathTracer::PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const S
   std::vector<shared::GpuLight> lights = gpuLights(scene);
   lightBuffer_ = lightTexels(ctx, lights);
   accum_ = gpu::Buffer(ctx, pixels * 2 * sizeof(glm::vec4), storage, "accumulation");
-  slots_ = uint32_t(std::min<size_t>(pixels, kMaxSlots));
+  // Whole samples of every pixel per generation, about kGenerationPaths paths, so that a small
+  // image's samples share the rounds' dispatches and the resolve; a large image (more pixels than
+  // kMaxSlots) goes in bands of kMaxSlots pixels, one sample each.
+  slots_ = pixels >= kMaxSlots ? kMaxSlots : uint32_t(std::max<size_t>(1, kGenerationPaths / pixels) * pixels);
   paths_ = gpu::Buffer(ctx, size_t(slots_) * shared::PT_PATH_BYTES, storage, "path slots");
   queues_ = gpu::Buffer(ctx, size_t(slots_) * 2 * sizeof(uint32_t), storage, "path queues");
   wave_ = gpu::Buffer(ctx, sizeof(shared::PtWave), storage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, "path queue lengths");

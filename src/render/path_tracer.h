@@ -36,8 +36,13 @@ class PathTracer {
   void beginFrame(int frame);
   // Traces `spp` more samples per pixel (waits for them).
   void addSamples(int spp);
-  // Path slots per generation (samples of several pixels traced together).
+  // Path slots per generation (samples of several pixels traced together): at most kMaxSlots, and
+  // whole samples of the image up to about kGenerationPaths. One sample per generation made each
+  // sample pay ~max_bounces rounds of dispatches and a resolve pass: on lavapipe 2^18 paths took
+  // the bundled smoke's 128² path tracer from ~7.7 to ~4.3 ms per sample and 256² by ~20%
+  // (notes/bench/kernels.md "Session 20"); 2^20 was no faster than 2^18.
   static constexpr uint32_t kMaxSlots = 1u << 20;
+  static constexpr uint32_t kGenerationPaths = 1u << 18;
   int samplesSoFar() const { return samples_; }
   Image readImage() const;  // mean + variance of the mean
   // The accumulation on the device (render/gpu_scene.h readAccumulation's layout), for a display
