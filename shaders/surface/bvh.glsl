@@ -12,7 +12,9 @@
 // Traversal"), so float rounding never misses a box that the ray touches; an axis the ray does
 // not move along is "every t" or "no t" by whether the origin lies in the slab (the product
 // 0 * inf would be NaN).
-// Traversal: a stack of BVH_STACK_SIZE entries, nearer child first; a stack entry packs a child
+// Traversal: a stack of PLUME_BVH_STACK entries (the host compiles the kernels with the built
+// tree's depth, the most far children that can wait at once: one per inner node on the path to
+// the current item; BVH_STACK_SIZE where it is not defined), nearer child first; a stack entry packs a child
 // reference as (ref << 3) | count (count 0: an inner node, 1..4: a leaf's triangles). One loop
 // iteration visits one node or tests one triangle (a leaf of n triangles stays the current item,
 // ref + 1 and n - 1, for n iterations): a SIMD back end runs the whole loop body on every
@@ -20,11 +22,19 @@
 // node visit of any lane (lavapipe: the city's path tracer 12 % faster without it, same hits). For
 // the same reason an iteration reads its item, node or triangle, with one set of four texel reads
 // (the layout of shared/bvh.h) instead of a node's four and a triangle's three (the city's path
-// tracer another 5-8 %).
+// tracer another 5-8 %). The stack is a shift register (push moves every entry down one place,
+// pop up one place, all with constant indices): a private array indexed by a variable becomes
+// per-lane scalar stores and loads on lavapipe, and entries kept in registers made the city's
+// path tracer ~8 % faster at 24 entries (notes/bench/kernels.md "Session 20"); its cost grows
+// with the entries, hence the tree's own depth.
 #ifndef PLUME_SURFACE_BVH_GLSL
 #define PLUME_SURFACE_BVH_GLSL
 
 #include "../shared/bvh.h"
+
+#ifndef PLUME_BVH_STACK
+#define PLUME_BVH_STACK BVH_STACK_SIZE
+#endif
 
 const float BVH_FAR_SCALE = 1.0000004f;  // 1 + 2 gamma(3), gamma(n) = n eps / (1 - n eps), eps = 2^-24
 const float BVH_BIG = 3.0e38f;
@@ -110,8 +120,8 @@ BvhHit bvh_traverse(BvhRay r, float tMin, float tMax, const bool anyHit) {
   hit.prim = BVH_NONE;
   hit.u = 0.0f;
   hit.v = 0.0f;
-  uint stack[BVH_STACK_SIZE];
-  int sp = 0;
+  uint stack[PLUME_BVH_STACK];
+  int sp = 0;  // entries in use
   uint item = 0u;  // the root, an inner node
   uint firstTriangle = BVH_TEXEL(0u).x;  // the header: triangle 0's texel
   while (true) {
@@ -130,7 +140,9 @@ BvhHit bvh_traverse(BvhRay r, float tMin, float tMax, const bool anyHit) {
       uint c1 = (node.ref1 << 3u) | node.count1;
       if (d0 < BVH_BIG && d1 < BVH_BIG) {
         bool firstNear = d0 <= d1;
-        stack[sp++] = firstNear ? c1 : c0;
+        for (int k = PLUME_BVH_STACK - 1; k > 0; --k) stack[k] = stack[k - 1];
+        stack[0] = firstNear ? c1 : c0;
+        ++sp;
         item = firstNear ? c0 : c1;
         continue;
       }
@@ -155,7 +167,9 @@ BvhHit bvh_traverse(BvhRay r, float tMin, float tMax, const bool anyHit) {
       }
     }
     if (sp == 0) break;
-    item = stack[--sp];
+    item = stack[0];
+    for (int k = 0; k < PLUME_BVH_STACK - 1; ++k) stack[k] = stack[k + 1];
+    --sp;
   }
   return hit;
 }

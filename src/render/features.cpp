@@ -1,6 +1,7 @@
 #include "render/features.h"
 
 #include <algorithm>
+#include <string>
 
 namespace plume {
 
@@ -14,6 +15,7 @@ gpu::ShaderDefines FeatureSet::defines() const {
   if (emission) d.emplace_back("PLUME_HAS_EMISSION", "1");
   if (blackbody) d.emplace_back("PLUME_EMISSION_BLACKBODY", "1");
   if (surfaces) d.emplace_back("PLUME_HAS_SURFACES", "1");
+  if (bvhStack > 0) d.emplace_back("PLUME_BVH_STACK", std::to_string(bvhStack));
   if (emitters) d.emplace_back("PLUME_HAS_EMITTERS", "1");
   if (hardwareFilter) d.emplace_back("PLUME_HW_FILTER", "1");
   if (kernelCounters) d.emplace_back("PLUME_KERNEL_COUNTERS", "1");

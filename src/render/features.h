@@ -24,6 +24,9 @@ struct FeatureSet {
   // The kernel benchmark's event counters in the walk (shared/kernel_counters.h): never a scene
   // feature, set only by `plume bench --kernels` (EstimatorOptions::kernelCounters).
   bool kernelCounters = false;
+  // The surfaces' BVH depth once it is built (GpuSurfaces::bvhStats): the traversal stack's
+  // entries, compiled in as PLUME_BVH_STACK (surface/bvh.glsl); 0: not built.
+  int bvhStack = 0;
   gpu::ShaderDefines defines() const;
   std::string name() const;  // e.g. "sun+env+multi", "env+envmap"
 };

@@ -22,7 +22,10 @@ PathTracer::PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const S
       timer_(ctx, 2 * kBouncesPerSubmit) {
   features_.kernelCounters = kernelCounters;
   envMap_ = std::make_unique<GpuEnvironmentMap>(ctx, scene);
-  if (features_.surfaces) surfaces_ = std::make_unique<GpuSurfaces>(ctx, scene);
+  if (features_.surfaces) {
+    surfaces_ = std::make_unique<GpuSurfaces>(ctx, scene);
+    features_.bvhStack = surfaces_->bvhStats().depth;
+  }
   const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   const size_t pixels = size_t(scene.camera.width) * scene.camera.height;
   frameBuffer_ = gpu::Buffer(ctx, sizeof(shared::GpuFrame), storage, "frame parameters");

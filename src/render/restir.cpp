@@ -100,7 +100,10 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
     : ctx_(ctx), scene_(scene), options_(options), features_(featuresOf(scene)), timer_(ctx, 32) {
   features_.kernelCounters = kernelCounters;
   envMap_ = std::make_unique<GpuEnvironmentMap>(ctx, scene);  // bad maps fail before compiling
-  if (features_.surfaces) surfaces_ = std::make_unique<GpuSurfaces>(ctx, scene);
+  if (features_.surfaces) {
+    surfaces_ = std::make_unique<GpuSurfaces>(ctx, scene);
+    features_.bvhStack = surfaces_->bvhStats().depth;
+  }
   if (options_.prefix < 1 || options_.prefix > int(shared::RS_MAX_VERTICES)) {
     throw InputError(scene.path + strf(": render.restir_prefix: expected 1 to %u (got %d)", shared::RS_MAX_VERTICES,
                                        options_.prefix));
