@@ -90,7 +90,8 @@ double cpuTau(const BakedVolume& vol, float scale, const Ray& r, double t) {
 }
 
 // The midpoint rule of vol_mean_tau_midpoints (ReSTIR's target for light rays), written out
-// independently: the ray's part inside the bricks' box (index space), cut into n = ceil(length in
+// independently: the ray's part inside the box where the field may be non-zero (the active voxels
+// grown by one, index space), cut into n = ceil(length in
 // voxels) equal steps, each weighted by the mean of the voxel its midpoint lies in (no exact
 // voxels: there the mean, or 0 where the residual bound exceeds twice the mean). The steps are
 // placed in float as the shader places them (a step count one off moves every midpoint), the sum
@@ -99,7 +100,7 @@ double cpuMidpoints(const BakedVolume& vol, float scale, const Ray& r, bool& exa
   exact = false;
   const glm::vec3 oI = glm::vec3(vol.worldToIndex * glm::vec4(r.o, 1.0f));
   const glm::vec3 dI = glm::vec3(vol.worldToIndex * glm::vec4(r.d, 0.0f));
-  const glm::vec3 lo = glm::vec3(vol.brickOrigin * 8), hi = lo + glm::vec3(vol.brickDims * 8);
+  const glm::vec3 lo = vol.indexBoundsMin, hi = vol.indexBoundsMax;
   float t0 = 0.0f, t1 = r.tMax;
   for (int a = 0; a < 3; ++a) {
     if (std::abs(dI[a]) < 1e-30f) {
