@@ -202,3 +202,33 @@ TEST_F(GpuPathTracer, DensityScaleSetInPlaceEqualsARebuiltVolume) {
   EXPECT_EQ(after.rgb, rebuilt.rgb);
   EXPECT_NE(after.rgb, before.rgb);
 }
+
+// A generation traces several samples of every pixel at once (PathTracer::kGenerationPaths); each
+// path's random stream is its pixel's and sample's and the resolve merges a pixel's samples in
+// sample order, so the image (mean and variance, every bit) does not depend on how the samples
+// are grouped into generations: all at once, one per call, or in uneven calls.
+TEST_F(GpuPathTracer, SamplesGroupedInGenerationsGiveTheSameImage) {
+  Scene s = denseCloudScene();
+  LoadedGrid loaded;
+  loaded.grid = test::makeBoxGrid(16, 1.0 / 16);
+  loaded.name = "density";
+  GpuVolumeResources volume(ctx(), bakeVolume(loaded), s.media[0].densityScale);
+  auto render = [&](const std::vector<int>& calls, uint32_t* perGeneration = nullptr) {
+    PathTracer tracer(ctx(), compiler(), s);
+    tracer.setVolume(volume);
+    tracer.beginFrame(3);
+    for (int n : calls) tracer.addSamples(n);
+    if (perGeneration) *perGeneration = tracer.samplesPerGeneration();
+    return tracer.readImage();
+  };
+  uint32_t perGeneration = 0;
+  const Image together = render({12}, &perGeneration);
+  EXPECT_GE(perGeneration, 12u);  // 24² pixels: one generation holds all 12 samples
+  const Image single = render(std::vector<int>(12, 1));
+  const Image uneven = render({5, 7});
+  EXPECT_EQ(single.rgb, together.rgb);
+  EXPECT_EQ(single.var, together.var);
+  EXPECT_EQ(uneven.rgb, together.rgb);
+  EXPECT_EQ(uneven.var, together.var);
+  EXPECT_GT(pixelsShowingMedium(together, together.pixel(0, 0)), 50);
+}

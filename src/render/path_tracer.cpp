@@ -195,6 +195,11 @@ void PathTracer::addSamples(int spp) {
   samples_ += spp;
 }
 
+uint32_t PathTracer::samplesPerGeneration() const {
+  const uint32_t pixels = uint32_t(scene_.camera.width) * uint32_t(scene_.camera.height);
+  return pixels <= slots_ ? slots_ / pixels : 1u;
+}
+
 Image PathTracer::readImage() const { return readAccumulation(accum_, scene_.camera.width, scene_.camera.height); }
 
 }  // namespace plume

@@ -44,6 +44,8 @@ class PathTracer {
   static constexpr uint32_t kMaxSlots = 1u << 20;
   static constexpr uint32_t kGenerationPaths = 1u << 18;
   int samplesSoFar() const { return samples_; }
+  // Samples of every pixel that one generation holds (1 where the image is split into bands).
+  uint32_t samplesPerGeneration() const;
   Image readImage() const;  // mean + variance of the mean
   // The accumulation on the device (render/gpu_scene.h readAccumulation's layout), for a display
   // pass that reads it in place.
