@@ -182,8 +182,11 @@ struct VolTrack {
 // Russian roulette on a transmittance estimate (unbiased): below VOL_RR_TRANSMITTANCE it
 // survives with probability |T| / VOL_RR_TRANSMITTANCE and is raised to that value, so an
 // estimate that can only add a little stops early instead of walking through the rest of a dense
-// medium, and a survivor's weight stays bounded.
-const float VOL_RR_TRANSMITTANCE = 0.01f;
+// medium, and a survivor's weight stays bounded. 0.1, the CPU reference's threshold (session 3
+// chose 0.01; session 20 measured 0.1 against it, two seeds, `plume bench` at 128²: the Blender
+// fire's path tracer 9-13% faster per frame at the same or lower relMSE, the bundled smoke equal;
+// next-event lookups per pixel had been 21% above the reference's; notes/bench/kernels.md).
+const float VOL_RR_TRANSMITTANCE = 0.1f;
 bool vol_transmittance_roulette(inout float tr, inout RngState rng) {
   float m = abs(tr);
   if (!(m < VOL_RR_TRANSMITTANCE)) return true;
