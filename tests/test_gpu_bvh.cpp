@@ -199,7 +199,7 @@ struct Tally {
 class GpuBvh : public test::GpuTest {
  protected:
   double traceMs = 0.0;  // the last trace's submit-to-finish time (closest + any hit per ray)
-  int stackSlack = 0;    // traversal stack entries beyond the tree's depth (ComparisonCanFail: -1)
+  int stackSlack = 0;    // traversal stack entries beyond the tree's depth (ShortStackFails: < 0)
   std::vector<RayResult> trace(const geo::FlatBvh& bvh, const std::vector<RayCase>& rays) {
     using gpu::BindingType;
     // The stack as the renderer compiles it: the tree's own depth (render/features.h bvhStack).

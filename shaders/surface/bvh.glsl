@@ -14,9 +14,9 @@
 // 0 * inf would be NaN).
 // Traversal: a stack of PLUME_BVH_STACK entries (the host compiles the kernels with the built
 // tree's depth, the most far children that can wait at once: one per inner node on the path to
-// the current item; BVH_STACK_SIZE where it is not defined), nearer child first; a stack entry packs a child
-// reference as (ref << 3) | count (count 0: an inner node, 1..4: a leaf's triangles). One loop
-// iteration visits one node or tests one triangle (a leaf of n triangles stays the current item,
+// the current item; BVH_STACK_SIZE where it is not defined), nearer child first; a stack entry
+// packs a child reference as (ref << 3) | count (count 0: an inner node, 1..4: a leaf's
+// triangles). One loop iteration visits one node or tests one triangle (a leaf of n triangles stays the current item,
 // ref + 1 and n - 1, for n iterations): a SIMD back end runs the whole loop body on every
 // iteration (../shared/docs/LAVAPIPE.md), and a triangle loop nested in it ran at least once per
 // node visit of any lane (lavapipe: the city's path tracer 12 % faster without it, same hits). For
@@ -24,9 +24,9 @@
 // (the layout of shared/bvh.h) instead of a node's four and a triangle's three (the city's path
 // tracer another 5-8 %). The stack is a shift register (push moves every entry down one place,
 // pop up one place, all with constant indices): a private array indexed by a variable becomes
-// per-lane scalar stores and loads on lavapipe, and entries kept in registers made the city's
-// path tracer ~8 % faster at 24 entries (notes/bench/kernels.md "Session 20"); its cost grows
-// with the entries, hence the tree's own depth.
+// per-lane scalar stores and loads on lavapipe; in registers, at the city's 17 entries, its path
+// tracer's extension and shading ran 6-7 % faster (notes/bench/kernels.md "Session 20"). Its
+// cost grows with the entries (session 19: -8 % at 24, -2 % at 48), hence the tree's own depth.
 #ifndef PLUME_SURFACE_BVH_GLSL
 #define PLUME_SURFACE_BVH_GLSL
 
