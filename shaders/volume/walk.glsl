@@ -365,60 +365,52 @@ void vol_track_event(uint tracker, inout VolTrack s, uint v, float scale, vec3 p
 #define VOL_KC_ARG
 #endif
 
-// One draw of a segment's tentative collisions at rate mu, from t on: true where the collision
-// falls before the segment's end b (h: its four numbers, h.y the event's u); otherwise the
-// segment is over (inSegment turns false) or the step cap ended the walk (s.stop).
-bool vol_draw_collision(inout VolTrack s, inout float t, float b, float mu, inout bool inSegment, inout uint steps,
-                        inout RngState rng, out uvec4 h VOL_KC_PARAM) {
-  h = uvec4(0u);
-  if (++steps > VOL_MAX_STEPS) {
-    s.stop = true;
-    return false;
-  }
-#ifdef PLUME_KERNEL_COUNTERS
-  vol_kc_step(kc);
-#endif
-  h = rng_next4(rng);
-  t -= log(1.0f - rng_to_float(h.x)) / mu;
-  if (t < b) return true;
-  inSegment = false;
-  return false;
-}
-
 // The walk's loops. A SIMD back end runs a loop's whole body on every iteration while any lane
 // needs it (../shared/docs/LAVAPIPE.md), so which code shares a loop matters. The majorant field
-// (delta and ratio tracking) is walked by collision: the outer loop makes one tentative
-// collision, one density lookup, per iteration; the inner loop takes the draws and cheap majorant
-// segments up to it and holds no lookup. The lookup then runs once per collision of the subgroup
-// instead of once per draw (path tracer extension 11 % faster). The mean field: below.
+// (delta and ratio tracking) is walked by collision: the outer loop draws one tentative
+// collision's optical depth and makes its density lookup; the inner loop spends that depth
+// across the majorant's segments and holds neither a draw nor a lookup. Each runs once per
+// tentative collision of the subgroup (the lookup in the outer loop: path tracer extension 11 %
+// faster, session 13). Until session 21 the inner loop also drew anew at each segment's entry
+// (a draw per segment crossed as well, and both kinds of work in every iteration): one draw per
+// collision made the bundled smoke's path tracer ~1.5x faster per sample and raised its lanes in
+// the tracking loop from 3.0 to 4.1 of 8 (notes/bench/kernels.md "Session 21"). The mean field:
+// below.
 void vol_track_by_collision(uint tracker, uint v, inout VolTrack s, inout VolWalk w, float scale, vec3 o,
                             vec3 d, inout uint steps, inout RngState rng VOL_KC_PARAM) {
   float a = 0.0f;
-  float b = 0.0f;
+  float b = 0.0f;  // the current segment [a, b) (none yet: the first is entered below)
   vec2 value = vec2(0.0f);
   float mu = 0.0f;
   float t = 0.0f;
-  bool inSegment = false;  // drawing tentative collisions in [a, b) at rate mu
   for (;;) {
-    bool found = false;
-    uvec4 h = uvec4(0u);
-    for (;;) {
-      if (inSegment) {
-        if (vol_draw_collision(s, t, b, mu, inSegment, steps, rng, h VOL_KC_ARG)) {
-          found = true;
-          break;
-        }
-        if (s.stop) break;
-      } else {
-        // A segment is entered only where the tracker still needs one.
-        if (!vol_track_alive(tracker, s) || !vol_walk_next(w, a, b, value)) break;
+    // The next tentative collision: an optical depth tau ~ Exp(1) of the process of rate mu from
+    // t on, spent across segments (one draw per tentative collision, not one per segment as well).
+    if (++steps > VOL_MAX_STEPS) {
+      s.stop = true;
+      break;
+    }
 #ifdef PLUME_KERNEL_COUNTERS
-        vol_kc_segment(kc);
+    vol_kc_step(kc);
 #endif
-        mu = vol_track_segment(tracker, s, a, b, value);
-        t = a;
-        inSegment = mu > 0.0f;
+    uvec4 h = rng_next4(rng);
+    float tau = -log(1.0f - rng_to_float(h.x));
+    bool found = false;
+    for (;;) {
+      float left = mu * (b - t);  // the optical depth left in the current segment
+      if (tau < left) {
+        t += tau / mu;
+        found = true;
+        break;
       }
+      tau -= left;
+      // A segment is entered only where the tracker still needs one.
+      if (!vol_track_alive(tracker, s) || !vol_walk_next(w, a, b, value)) break;
+#ifdef PLUME_KERNEL_COUNTERS
+      vol_kc_segment(kc);
+#endif
+      mu = vol_track_segment(tracker, s, a, b, value);
+      t = a;
     }
     if (!found) break;
 #ifdef PLUME_KERNEL_COUNTERS
@@ -513,72 +505,89 @@ void vol_track_mean_closed(uint tracker, inout VolTrack s, inout VolWalk w, floa
   }
 }
 
-// Residual ratio tracking: the voxel loop also draws the tentative collisions and leaves at one.
+// Residual ratio tracking: the voxel loop spends the optical depth to the next tentative
+// collision of the residual's process (drawn in the outer loop, as vol_track_by_collision's) and
+// leaves at one.
 const uint VOL_PENDING_NONE = 0u;
 const uint VOL_PENDING_EXACT = 1u;  // an exact voxel over [a, b)
 const uint VOL_PENDING_EVENT = 2u;  // a tentative collision at t
 void vol_track_mean_residual(uint tracker, uint v, inout VolTrack s, inout VolWalk w, float scale, vec3 o, vec3 d,
                              inout uint steps, inout RngState rng VOL_KC_PARAM) {
   bool innerLive = false;
-  bool inSegment = false;  // drawing tentative collisions in [a, b) at rate mu
   uint pending = VOL_PENDING_NONE;
+  bool draw = true;  // the next tentative collision's optical depth is to be drawn
   float a = 0.0f;
   float b = 0.0f;
   vec2 value = vec2(0.0f);
-  float mu = 0.0f;
-  float t = 0.0f;
+  float mu = 0.0f;   // the residual's rate in [a, b)
+  float t = 0.0f;    // [t, b) is what is left of the current voxel
+  float tau = 0.0f;  // the optical depth to the next tentative collision
   uvec4 h = uvec4(0u);
   for (;;) {
     if (pending == VOL_PENDING_EXACT) {
-      vol_track_exact(tracker, s, w, scale, a, b);
+      vol_track_exact(tracker, s, w, scale, a, b);  // the residual is 0 there: tau carries over
     } else if (pending == VOL_PENDING_EVENT) {
 #ifdef PLUME_KERNEL_COUNTERS
       vol_kc_lookup(kc);
 #endif
       vol_track_event(tracker, s, v, scale, o + t * d, t, mu, value, rng_to_float(h.y), rng);
       if (s.stop) break;
+      draw = true;
     }
     pending = VOL_PENDING_NONE;
-    if (!inSegment) {
-      if (!vol_track_alive(tracker, s)) break;
-      if (!innerLive) {
-        if (!vol_mean_enter_brick(w)) break;
-        innerLive = true;
+    if (draw) {
+      if (++steps > VOL_MAX_STEPS) {
+        s.stop = true;
+        break;
       }
+#ifdef PLUME_KERNEL_COUNTERS
+      vol_kc_step(kc);
+#endif
+      h = rng_next4(rng);
+      tau = -log(1.0f - rng_to_float(h.x));
+      draw = false;
+    }
+    if (!vol_track_alive(tracker, s)) break;
+    if (!innerLive) {
+      if (!vol_mean_enter_brick(w)) break;
+      innerLive = true;
     }
     for (;;) {
-      if (inSegment) {
-        if (vol_draw_collision(s, t, b, mu, inSegment, steps, rng, h VOL_KC_ARG)) {
-          pending = VOL_PENDING_EVENT;
-          break;
-        }
-        if (s.stop) break;
-      } else {
-        bool exact;
-        if (!vol_track_alive(tracker, s)) break;
-        if (!vol_mean_next_voxel(w, a, b, value, exact)) {
-          innerLive = false;
-          break;
-        }
-#ifdef PLUME_KERNEL_COUNTERS
-        vol_kc_segment(kc);
-#endif
-        if (exact) {
-          pending = VOL_PENDING_EXACT;
-          break;
-        }
-        mu = vol_track_segment(tracker, s, a, b, value);
-        t = a;
-        inSegment = mu > 0.0f;
+      float left = mu * (b - t);
+      if (tau < left) {
+        t += tau / mu;
+        pending = VOL_PENDING_EVENT;
+        break;
       }
+      tau -= left;
+      t = b;
+      bool exact;
+      if (!vol_track_alive(tracker, s)) break;
+      if (!vol_mean_next_voxel(w, a, b, value, exact)) {
+        innerLive = false;
+        break;
+      }
+#ifdef PLUME_KERNEL_COUNTERS
+      vol_kc_segment(kc);
+#endif
+      if (exact) {
+        mu = 0.0f;
+        t = b;
+        pending = VOL_PENDING_EXACT;
+        break;
+      }
+      mu = vol_track_segment(tracker, s, a, b, value);
+      t = a;
     }
-    if (s.stop) break;
+    if (pending == VOL_PENDING_NONE && (innerLive || !vol_track_alive(tracker, s))) break;
   }
 }
 #endif
 // The walk. `init`: the tracker's starting value (RATIO, RESIDUAL 1; TAU 0; SAMPLE the optical
-// depth to the collision). Tentative collisions restart at each segment's entry (exponential
-// steps are memoryless); each step draws one rng_next4 (its x: the step, its y: the event's u).
+// depth to the collision). Each tentative collision of the majorant's (or the residual's) Poisson
+// process draws one rng_next4: its x the optical depth Exp(1) to it from the last one, spent
+// across segments of different rates (the inverse of the piecewise-linear optical depth), its y
+// the event's u.
 VolTrack vol_track(uint tracker, uint v, vec3 xWorld, vec3 wWorld, float tMax, float init, inout RngState rng) {
   VolTrack s;
   s.value = init;
