@@ -134,7 +134,7 @@ bool pt_extend(uint slot, bool camera) {
     p.shading = vec3(0.0f);
     p.pad = 0u;
   } else {
-    p = ptPaths[slot];
+    p = pt_load_ray(slot);
     rng.counter = p.counter;
   }
   PathSegment seg = path_segment(p.origin, p.dir, rng);
@@ -176,7 +176,12 @@ bool pt_extend(uint slot, bool camera) {
   }
   if (vertex && ++p.scatterings > frame.maxBounces) vertex = false;
   p.counter = rng.counter;
-  ptPaths[slot] = p;
+  // The ray (dir, phasePdf) is the one shading drew, or the camera's: stored only for a camera ray.
+  if (camera) {
+    ptPaths[slot].dir = p.dir;
+    ptPaths[slot].phasePdf = p.phasePdf;
+  }
+  pt_store_vertex(slot, p);
   return vertex;
 }
 
@@ -193,7 +198,7 @@ PathVertex pt_vertex(PtPath p) {
 // sampled by the vertex's phase function or BSDF. True where the path goes on to another
 // extension.
 bool pt_shade(uint slot) {
-  PtPath p = ptPaths[slot];
+  PtPath p = pt_load_vertex(slot);
   RngState rng = pt_slot_rng(slot, p.counter);
   PathVertex v = pt_vertex(p);
   p.radiance += p.beta * pt_direct(v, rng);
@@ -203,8 +208,13 @@ bool pt_shade(uint slot) {
   more = path_roulette(p.scatterings, min(1.0f, plume_max3(p.beta)), rng, p.beta) &&
          path_scatter(v, rng_float2(rng), p.beta, p.origin, p.dir, p.phasePdf);
 #endif
-  p.counter = rng.counter;
-  ptPaths[slot] = p;
+  ptPaths[slot].radiance = p.radiance;
+#ifdef PT_FOLLOWS_PHASE
+  if (more) {
+    p.counter = rng.counter;
+    pt_store_ray(slot, p);
+  }
+#endif
   return more;
 }
 

@@ -43,6 +43,66 @@ layout(std430, binding = BIND_PT_QUEUES) buffer QueueBuffer { uint ptQueues[]; }
 layout(std430, binding = BIND_PT_WAVE) buffer WaveBuffer { PtWave wave; };
 layout(push_constant) uniform PtPushBlock { PtPush ptPush; };
 
+// A path's fields are read and written one by one, only those a kernel needs or changes: on a
+// SIMD back end each storage-buffer word costs a scalar loop over the lanes (LAVAPIPE.md).
+// Extension reads the ray it follows and what it adds to; shading, the vertex it waits at.
+PtPath pt_load_ray(uint slot) {
+  PtPath p;
+  p.origin = ptPaths[slot].origin;
+  p.phasePdf = ptPaths[slot].phasePdf;
+  p.dir = ptPaths[slot].dir;
+  p.scatterings = ptPaths[slot].scatterings;
+  p.beta = ptPaths[slot].beta;
+  p.counter = ptPaths[slot].counter;
+  p.radiance = ptPaths[slot].radiance;
+  p.prim = PT_MEDIUM_VERTEX;
+  p.shading = vec3(0.0f);
+  p.pad = 0u;
+  return p;
+}
+
+// After extension: the vertex (or the finished path's radiance).
+void pt_store_vertex(uint slot, PtPath p) {
+  ptPaths[slot].origin = p.origin;
+  ptPaths[slot].scatterings = p.scatterings;
+  ptPaths[slot].beta = p.beta;
+  ptPaths[slot].counter = p.counter;
+  ptPaths[slot].radiance = p.radiance;
+#ifdef PLUME_HAS_SURFACES
+  ptPaths[slot].prim = p.prim;
+  ptPaths[slot].shading = p.shading;
+#endif
+}
+
+PtPath pt_load_vertex(uint slot) {
+  PtPath p;
+  p.origin = ptPaths[slot].origin;
+  p.phasePdf = 0.0f;
+  p.dir = ptPaths[slot].dir;
+  p.scatterings = ptPaths[slot].scatterings;
+  p.beta = ptPaths[slot].beta;
+  p.counter = ptPaths[slot].counter;
+  p.radiance = ptPaths[slot].radiance;
+#ifdef PLUME_HAS_SURFACES
+  p.prim = ptPaths[slot].prim;
+  p.shading = ptPaths[slot].shading;
+#else
+  p.prim = PT_MEDIUM_VERTEX;
+  p.shading = vec3(0.0f);
+#endif
+  p.pad = 0u;
+  return p;
+}
+
+// After shading, for a path that goes on: the ray leaving its vertex.
+void pt_store_ray(uint slot, PtPath p) {
+  ptPaths[slot].counter = p.counter;
+  ptPaths[slot].origin = p.origin;
+  ptPaths[slot].phasePdf = p.phasePdf;
+  ptPaths[slot].dir = p.dir;
+  ptPaths[slot].beta = p.beta;
+}
+
 // The pixel of a slot, and the index of its sample in the frame.
 uint pt_slot_sample(uint slot, out uvec2 pixel) {
   uint p = ptPush.pixelBegin + slot % ptPush.pixelCount;
