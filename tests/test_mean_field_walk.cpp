@@ -101,13 +101,16 @@ double cpuMidpoints(const BakedVolume& vol, float scale, const Ray& r, bool& exa
   const glm::vec3 oI = glm::vec3(vol.worldToIndex * glm::vec4(r.o, 1.0f));
   const glm::vec3 dI = glm::vec3(vol.worldToIndex * glm::vec4(r.d, 0.0f));
   const glm::vec3 lo = vol.indexBoundsMin, hi = vol.indexBoundsMax;
+  // The slabs as vol_clip_to_bounds takes them (times the reciprocal; an axis the ray does not
+  // move along keeps an origin inside [lo, hi]).
   float t0 = 0.0f, t1 = r.tMax;
   for (int a = 0; a < 3; ++a) {
-    if (std::abs(dI[a]) < 1e-30f) {
-      if (oI[a] < lo[a] || oI[a] >= hi[a]) return 0.0;
+    if (dI[a] == 0.0f) {
+      if (oI[a] < lo[a] || oI[a] > hi[a]) return 0.0;
       continue;
     }
-    const float ta = (lo[a] - oI[a]) / dI[a], tb = (hi[a] - oI[a]) / dI[a];
+    const float inv = 1.0f / dI[a];
+    const float ta = (lo[a] - oI[a]) * inv, tb = (hi[a] - oI[a]) * inv;
     t0 = std::max(t0, std::min(ta, tb));
     t1 = std::min(t1, std::max(ta, tb));
   }

@@ -134,7 +134,7 @@ bool pt_extend(uint slot, bool camera) {
     p.shading = vec3(0.0f);
     p.pad = 0u;
   } else {
-    p = pt_load_ray(slot);
+    p = pt_load(slot, false);
     rng.counter = p.counter;
   }
   PathSegment seg = path_segment(p.origin, p.dir, rng);
@@ -198,7 +198,7 @@ PathVertex pt_vertex(PtPath p) {
 // sampled by the vertex's phase function or BSDF. True where the path goes on to another
 // extension.
 bool pt_shade(uint slot) {
-  PtPath p = pt_load_vertex(slot);
+  PtPath p = pt_load(slot, true);
   RngState rng = pt_slot_rng(slot, p.counter);
   PathVertex v = pt_vertex(p);
   p.radiance += p.beta * pt_direct(v, rng);

@@ -45,18 +45,25 @@ layout(push_constant) uniform PtPushBlock { PtPush ptPush; };
 
 // A path's fields are read and written one by one, only those a kernel needs or changes: on a
 // SIMD back end each storage-buffer word costs a scalar loop over the lanes (LAVAPIPE.md).
-// Extension reads the ray it follows and what it adds to; shading, the vertex it waits at.
-PtPath pt_load_ray(uint slot) {
+// Extension reads the ray it follows and what it adds to (atVertex false); shading, the vertex it
+// waits at (atVertex true; a constant at each call).
+PtPath pt_load(uint slot, const bool atVertex) {
   PtPath p;
   p.origin = ptPaths[slot].origin;
-  p.phasePdf = ptPaths[slot].phasePdf;
   p.dir = ptPaths[slot].dir;
   p.scatterings = ptPaths[slot].scatterings;
   p.beta = ptPaths[slot].beta;
   p.counter = ptPaths[slot].counter;
   p.radiance = ptPaths[slot].radiance;
+  p.phasePdf = atVertex ? 0.0f : ptPaths[slot].phasePdf;
   p.prim = PT_MEDIUM_VERTEX;
   p.shading = vec3(0.0f);
+#ifdef PLUME_HAS_SURFACES
+  if (atVertex) {
+    p.prim = ptPaths[slot].prim;
+    p.shading = ptPaths[slot].shading;
+  }
+#endif
   p.pad = 0u;
   return p;
 }
@@ -72,26 +79,6 @@ void pt_store_vertex(uint slot, PtPath p) {
   ptPaths[slot].prim = p.prim;
   ptPaths[slot].shading = p.shading;
 #endif
-}
-
-PtPath pt_load_vertex(uint slot) {
-  PtPath p;
-  p.origin = ptPaths[slot].origin;
-  p.phasePdf = 0.0f;
-  p.dir = ptPaths[slot].dir;
-  p.scatterings = ptPaths[slot].scatterings;
-  p.beta = ptPaths[slot].beta;
-  p.counter = ptPaths[slot].counter;
-  p.radiance = ptPaths[slot].radiance;
-#ifdef PLUME_HAS_SURFACES
-  p.prim = ptPaths[slot].prim;
-  p.shading = ptPaths[slot].shading;
-#else
-  p.prim = PT_MEDIUM_VERTEX;
-  p.shading = vec3(0.0f);
-#endif
-  p.pad = 0u;
-  return p;
 }
 
 // After shading, for a path that goes on: the ray leaving its vertex.

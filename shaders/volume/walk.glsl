@@ -365,6 +365,23 @@ void vol_track_event(uint tracker, inout VolTrack s, uint v, float scale, vec3 p
 #define VOL_KC_ARG
 #endif
 
+// One draw of the next tentative collision: h (h.y: the event's u) and the optical depth tau ~
+// Exp(1) to it; false where the step cap ends the walk (s.stop).
+bool vol_draw_depth(inout VolTrack s, inout uint steps, inout RngState rng, out uvec4 h, out float tau VOL_KC_PARAM) {
+  h = uvec4(0u);
+  tau = 0.0f;
+  if (++steps > VOL_MAX_STEPS) {
+    s.stop = true;
+    return false;
+  }
+#ifdef PLUME_KERNEL_COUNTERS
+  vol_kc_step(kc);
+#endif
+  h = rng_next4(rng);
+  tau = -log(1.0f - rng_to_float(h.x));
+  return true;
+}
+
 // The walk's loops. A SIMD back end runs a loop's whole body on every iteration while any lane
 // needs it (../shared/docs/LAVAPIPE.md), so which code shares a loop matters. The majorant field
 // (delta and ratio tracking) is walked by collision: the outer loop draws one tentative
@@ -386,15 +403,9 @@ void vol_track_by_collision(uint tracker, uint v, inout VolTrack s, inout VolWal
   for (;;) {
     // The next tentative collision: an optical depth tau ~ Exp(1) of the process of rate mu from
     // t on, spent across segments (one draw per tentative collision, not one per segment as well).
-    if (++steps > VOL_MAX_STEPS) {
-      s.stop = true;
-      break;
-    }
-#ifdef PLUME_KERNEL_COUNTERS
-    vol_kc_step(kc);
-#endif
-    uvec4 h = rng_next4(rng);
-    float tau = -log(1.0f - rng_to_float(h.x));
+    uvec4 h;
+    float tau;
+    if (!vol_draw_depth(s, steps, rng, h, tau VOL_KC_ARG)) break;
     bool found = false;
     for (;;) {
       float left = mu * (b - t);  // the optical depth left in the current segment
@@ -536,15 +547,7 @@ void vol_track_mean_residual(uint tracker, uint v, inout VolTrack s, inout VolWa
     }
     pending = VOL_PENDING_NONE;
     if (draw) {
-      if (++steps > VOL_MAX_STEPS) {
-        s.stop = true;
-        break;
-      }
-#ifdef PLUME_KERNEL_COUNTERS
-      vol_kc_step(kc);
-#endif
-      h = rng_next4(rng);
-      tau = -log(1.0f - rng_to_float(h.x));
+      if (!vol_draw_depth(s, steps, rng, h, tau VOL_KC_ARG)) break;
       draw = false;
     }
     if (!vol_track_alive(tracker, s)) break;
@@ -695,21 +698,9 @@ float vol_mean_tau_midpoints(uint v, vec3 xWorld, vec3 wWorld, float tMax) {
   vol_ray_to_index(v, xWorld, wWorld, o, d);
   // The ray's part inside the box where the field may be non-zero (index space; t in world units
   // along wWorld; the mean field's voxels outside it have only zero corners).
-  vec3 lo = VOL_PARAM(v, boundsMin);
-  vec3 hi = VOL_PARAM(v, boundsMax);
-  float t0 = 0.0f;
-  float t1 = tMax;
-  for (int a = 0; a < 3; ++a) {
-    if (abs(d[a]) < 1e-30f) {
-      if (o[a] < lo[a] || o[a] >= hi[a]) t1 = -1.0f;
-    } else {
-      float ta = (lo[a] - o[a]) / d[a];
-      float tb = (hi[a] - o[a]) / d[a];
-      t0 = max(t0, min(ta, tb));
-      t1 = min(t1, max(ta, tb));
-    }
-  }
-  if (!(t0 < t1)) return 0.0f;
+  float t0;
+  float t1;
+  if (!vol_clip_to_bounds(VOL_PARAM(v, boundsMin), VOL_PARAM(v, boundsMax), o, d, tMax, t0, t1)) return 0.0f;
   uint n = max(1u, uint(ceil((t1 - t0) * length(d))));  // steps of at most one voxel
   float h = (t1 - t0) / float(n);
   float sum = 0.0f;

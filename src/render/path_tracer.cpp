@@ -184,7 +184,7 @@ void PathTracer::addSamples(int spp) {
   passTimes_.clear();
   for (uint32_t done = 0; done < uint32_t(spp);) {
     if (pixels <= slots_) {
-      const uint32_t n = std::min(uint32_t(spp) - done, slots_ / pixels);
+      const uint32_t n = std::min(uint32_t(spp) - done, samplesPerGeneration());
       traceGeneration(0u, pixels, done, n);
       done += n;
     } else {
