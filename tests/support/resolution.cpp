@@ -1,5 +1,8 @@
 #include "support/resolution.h"
 
+#include "geometry/bvh.h"
+#include "geometry/scene_mesh.h"
+
 #include <glm/glm.hpp>
 #include <openvdb/tools/Interpolation.h>
 #include <tbb/blocked_range.h>
@@ -7,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
 namespace plume::test {
 
@@ -93,6 +97,14 @@ ResolutionMap referenceResolution(const Scene& scene, const openvdb::FloatGrid& 
                                   int raysPerAxis, double minCollisions) {
   const CameraRays cam(scene.camera, frame);
   const OpticalDepth depth(density, scene.medium().densityScale);
+  // With surfaces, a camera ray that meets one has a vertex there for sure (when the medium
+  // has none before it).
+  std::unique_ptr<geo::EmbreeScene> surfaces;
+  if (!scene.surfaces.empty()) surfaces = std::make_unique<geo::EmbreeScene>(geo::loadSceneSurfaces(scene).mesh);
+  auto vertexProbability = [&](const glm::dvec3& d) {
+    if (surfaces && surfaces->occluded(glm::vec3(cam.position), glm::vec3(d), 0.0f, 1e30f)) return 1.0;
+    return -std::expm1(-depth(cam.position, d));
+  };
   ResolutionMap map;
   map.width = cam.width;
   map.height = cam.height;
@@ -107,7 +119,7 @@ ResolutionMap referenceResolution(const Scene& scene, const openvdb::FloatGrid& 
       for (int a = 0; a < raysPerAxis; ++a) {
         for (int b = 0; b < raysPerAxis; ++b) {
           const double u = (a + 0.5) / raysPerAxis, v = (b + 0.5) / raysPerAxis;
-          p += -std::expm1(-depth(cam.position, cam.direction(px, py, u, v)));
+          p += vertexProbability(cam.direction(px, py, u, v));
           near |= depth(cam.position, cam.direction(px, py, 2.0 * u - 0.5, 2.0 * v - 0.5)) > 0.0;
         }
       }

@@ -3,15 +3,17 @@
 // Every path that reaches the camera starts with a collision on a camera ray of its pixel, so a
 // reference of N samples per pixel has about N·P samples that are not zero there, with
 //   P = E[1 - exp(-tau)]   over the pixel's camera rays (box filter), tau their optical depth,
-// the pixel's first-collision probability. Where N·P is small the reference is nearly always
-// exactly 0 with a variance estimate of 0, while its true value is positive: an estimator that
-// does reach the pixel (reuse brings paths into it from its neighbours) is then "significantly"
-// above the reference however right it is, and the more so the more runs it is given. This is
+// the pixel's first-collision probability. With surfaces a path's first vertex is the nearer of
+// the medium's collision and the first surface, so a camera ray that meets a surface counts 1.
+// Where N·P is small the reference is nearly always exactly 0 with a variance estimate of 0,
+// while its true value is positive: an estimator that does reach the pixel (reuse brings paths
+// into it from its neighbours) is then "significantly" above the reference however right it
+// is, and the more so the more runs it is given. This is
 // what failed the ReSTIR tests on the Blender fire (notes/restir.md, "Thin wisps"): Mantaflow's
 // wisps of density 1e-6 give P of 1e-6 to 1e-10 at 16², far beyond any affordable N.
 //
-// The map is computed from the camera and the OpenVDB grid alone (never from an image), by
-// marching a grid of rays per pixel with the trilinear sampler the reference uses.
+// The map is computed from the camera, the OpenVDB grid and the surfaces alone (never from an
+// image), by marching a grid of rays per pixel with the trilinear sampler the reference uses.
 #pragma once
 
 #include "scene/scene.h"

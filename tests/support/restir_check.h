@@ -1,13 +1,16 @@
 // ReSTIR against the CPU reference on a scene built in code
 // (tests/test_restir_surfaces*.cpp): independent one-frame runs of spatial
 // reuse (support/extreme.h runRestirCase), the per-pixel and aggregate checks
-// of support/reference_check.h, for each MIS kind asked for.
+// of support/reference_check.h, for each MIS kind asked for. Pixels the
+// reference does not resolve (support/resolution.h: fewer than 100 expected
+// first vertices on their camera rays) are left out of the per-pixel test.
 #pragma once
 
 #include "reference/reference.h"
 #include "render/restir.h"
 #include "support/extreme.h"
 #include "support/reference_check.h"
+#include "support/resolution.h"
 
 #include <cstdio>
 #include <string>
@@ -49,7 +52,9 @@ inline void expectRestirMatchesReference(
     const RestirOptions &base = spatialReuse(shared::RS_MIS_PAIRWISE),
     int framesPerRun = 1, openvdb::FloatGrid::Ptr previousGrid = nullptr) {
   // A moving camera (s.camera.keys) is measured at the last frame's pose.
-  const Image ref = restirCheckReference(s, grid, refSpp, s.camera.keys.empty() ? 1 : framesPerRun);
+  const int refFrame = s.camera.keys.empty() ? 1 : framesPerRun;
+  const Image ref = restirCheckReference(s, grid, refSpp, refFrame);
+  const ResolutionMap resolution = referenceResolution(s, *grid, refSpp, refFrame);
   ExtremeCase c;
   c.name = name;
   c.scene = s;
@@ -63,6 +68,7 @@ inline void expectRestirMatchesReference(
     const EstimatorRun run = runRestirCase(ctx, compiler, c, runs, options, framesPerRun);
     ReferenceCheckOptions check;
     check.imageMeanVariance = run.imageMeanVariance;
+    check.unresolved = resolution.unresolvedMask();
     check.outputGroup = "restir_surfaces";
     const ReferenceCheck result =
         expectMatchesReference(run.image, ref, label, check);
