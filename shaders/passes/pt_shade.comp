@@ -3,7 +3,10 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 
-layout(local_size_x = 64) in;
+#include "../shared/pt_wave.h"
+
+// The host dispatches groups of PT_WAVE_GROUP (render/path_tracer.cpp): one constant for both.
+layout(local_size_x = PT_WAVE_GROUP) in;
 
 #include "../volume/bindings.glsl"
 #include "../scene/bindings.glsl"
