@@ -176,13 +176,18 @@ bool pt_extend(uint slot, bool camera) {
   }
   if (vertex && ++p.scatterings > frame.maxBounces) vertex = false;
   p.counter = rng.counter;
-  // The ray (dir, phasePdf) is the one shading drew, or the camera's: stored only for a camera ray.
+  // A finished path leaves only its radiance (pt_resolve reads nothing else). The ray (dir,
+  // phasePdf) is the one shading drew, or the camera's: stored only for a camera ray.
+  if (!vertex) {
+    ptPaths[slot].radiance = p.radiance;
+    return false;
+  }
   if (camera) {
     ptPaths[slot].dir = p.dir;
     ptPaths[slot].phasePdf = p.phasePdf;
   }
   pt_store_vertex(slot, p);
-  return vertex;
+  return true;
 }
 
 // The vertex the path in p waits at (after pt_extend).
