@@ -18,7 +18,7 @@ struct RsInputs {
   uint set;                         // reservoir set of every input but the history
   uint historySet;                  // reservoir set of input 1 when `history`
   bool history;                     // input 1 is the previous frame's (its domain, its volume)
-  bool sameDomain;                  // ... and that domain is input 0's (still camera and volume)
+  uint hasSample;                   // bit s: input s holds a path (W > 0, a stored path)
   uint pixel[RS_MAX_INPUTS];        // pixel index of each input
   RsReservoir res[RS_MAX_INPUTS];   // its reservoir (confidence already capped)
 };
@@ -34,20 +34,72 @@ RsDomain rs_input_domain(uint j) {
   return (j == 1u && in_.history) ? rs_previous_domain(p) : rs_current_domain(p);
 }
 
-// p̂ of input s's path in input j's domain (the stored value when j == s or when both share
-// the domain: the same deterministic function of the same arguments).
+#ifndef PLUME_RS_MIS
+#define PLUME_RS_MIS RS_MIS_PAIRWISE
+#endif
+// PLUME_RS_SAME_DOMAIN 1: the temporal pass of a frame whose history has the current domain (a
+// still camera over the volume it was rendered with; the host knows: Restir::fillFrame). The
+// shift is the identity, the history pixel is the pixel itself, and every target is a stored
+// one: the pipeline holds no target evaluation at all (on lavapipe the masked-off evaluations
+// of the general pipeline cost ~10 ms per iteration at 128², session 23).
+#ifndef PLUME_RS_SAME_DOMAIN
+#define PLUME_RS_SAME_DOMAIN 0
+#endif
+
+// The cross-domain targets p̂_j(y_s), s != j, that the resampling weights and the MIS kind read:
+// the neighbours' paths in the canonical domain (every kind), the canonical path in each
+// neighbour's (pairwise), every pair (GBH). They are evaluated before resampling, in one loop
+// around one call of rs_target: a SIMD back end such as lavapipe runs the straight-line code of
+// every call site under a mask, and a loop's body at least once, so each call site the
+// resampling loop and MIS had (one inside a loop nested in the other) cost a whole target walk
+// even where no lane needed it (spatial reuse, session 23: ten walks' time for six targets).
+const uint RS_PAIRS_MAX = RS_MAX_INPUTS * RS_MAX_INPUTS;
+float rsCross[RS_PAIRS_MAX];  // p̂_j(y_s) at s * RS_MAX_INPUTS + j (shader-private, as in_)
+
+uint rs_pair_count(uint count) {
+  uint n = count - 1u;
+  return PLUME_RS_MIS == RS_MIS_GBH ? count * n : PLUME_RS_MIS == RS_MIS_PAIRWISE ? 2u * n : n;
+}
+
+// Pair t of rs_pair_count(count): (s, j).
+uvec2 rs_pair(uint t, uint count) {
+  uint n = count - 1u;
+  if (PLUME_RS_MIS == RS_MIS_GBH) {
+    uint s = t / n;
+    uint r = t - s * n;
+    return uvec2(s, r >= s ? r + 1u : r);
+  }
+  return t < n ? uvec2(t + 1u, 0u) : uvec2(0u, t - n + 1u);
+}
+
+bool rs_has_sample(uint s) { return (in_.hasSample & (1u << s)) != 0u; }
+
+void rs_cross_targets() {
+#if !PLUME_RS_SAME_DOMAIN
+  uint pairs = rs_pair_count(in_.count);
+  for (uint t = 0u; t < pairs; ++t) {
+    uvec2 sj = rs_pair(t, in_.count);
+    float v = 0.0f;
+    if (rs_has_sample(sj.x)) v = rs_target(rs_input_domain(sj.y), rs_input_set(sj.x), in_.pixel[sj.x]);
+    rsCross[sj.x * RS_MAX_INPUTS + sj.y] = v;
+  }
+#endif
+}
+
+// p̂ of input s's path in input j's domain: the stored value when j == s (or in one domain),
+// else rs_cross_targets' (for the pairs it evaluates; input s holding a path).
 float rs_target_in(uint s, uint j) {
-  if (j == s || (in_.sameDomain && s <= 1u && j <= 1u)) return in_.res[s].p_hat;
-  return rs_target(rs_input_domain(j), rs_input_set(s), in_.pixel[s]);
+#if PLUME_RS_SAME_DOMAIN
+  return in_.res[s].p_hat;
+#else
+  return j == s ? in_.res[s].p_hat : rsCross[s * RS_MAX_INPUTS + j];
+#endif
 }
 
 // Resamples the inputs into input 0's domain; writes the reservoir and the selected path to
 // (outSet, outPixel). The MIS kind is compiled in (PLUME_RS_MIS: RS_MIS_PAIRWISE, RS_MIS_GBH or
 // RS_MIS_BIASED): a SIMD back end such as lavapipe runs every branch's straight-line code under
 // a mask, so the kinds not taken cost time unless they are not there (-20 to -40% per pass).
-#ifndef PLUME_RS_MIS
-#define PLUME_RS_MIS RS_MIS_PAIRWISE
-#endif
 // MIS (shared/restir_mis.h) reads the inputs through these accessors.
 #define RS_MIS_M(j) in_.res[j].M
 #define RS_MIS_OWN_TARGET(s) in_.res[s].p_hat
@@ -57,14 +109,18 @@ float rs_target_in(uint s, uint j) {
 void rs_reuse(uint outSet, uint outPixel, inout RngState rng) {
   float Msum = 0.0f;
   for (uint s = 0u; s < in_.count; ++s) Msum += in_.res[s].M;
+  in_.hasSample = 0u;
+  for (uint s = 0u; s < in_.count; ++s) {
+    if (in_.res[s].W > 0.0f && rs_path_length(rs_input_set(s), in_.pixel[s]) > 0u) in_.hasSample |= 1u << s;
+  }
+  rs_cross_targets();
   RsReservoir out_ = rs_empty();
   uint selected = RS_MAX_INPUTS;
   for (uint s = 0u; s < in_.count; ++s) {
     RsReservoir rs_ = in_.res[s];
-    bool hasSample = rs_.W > 0.0f && rs_path_length(rs_input_set(s), in_.pixel[s]) > 0u;
     float phC = 0.0f;
     float m = 0.0f;
-    if (hasSample) {
+    if (rs_has_sample(s)) {
       phC = rs_target_in(s, 0u);
       m = rs_mis_weight(PLUME_RS_MIS, s, in_.count, Msum, phC);
     }
@@ -109,18 +165,20 @@ void rs_reuse_pixel(uvec2 pixel, uint index, bool temporal, uint spatialRound, u
   in_.set = inSet;
   in_.historySet = histSet;
   in_.history = false;
-  in_.sameDomain = false;
   in_.pixel[0] = index;
   in_.res[0] = rs_load(inSet, index);
   uint stream = temporal ? RNG_STREAM_TEMPORAL : RNG_STREAM_SPATIAL + (spatialRound << 8u);
   RngState rng = rng_init(pixel, frame.frameKey, stream, frame.seed);
   if (temporal) {
-    uvec2 q;
+    uvec2 q = pixel;
+#if PLUME_RS_SAME_DOMAIN
+    if (true) {  // the identity shift (the host dispatches this pipeline with a valid history)
+#else
     if (rsp.historyValid != 0u && rs_reproject(pixel, q)) {
+#endif
       uint qi = q.y * frame.size.x + q.x;
       in_.history = true;
       in_.pixel[1] = qi;
-      in_.sameDomain = rsp.historySameDomain != 0u && qi == index;
       in_.res[1] = rs_load(histSet, qi);
       rs_cap_confidence(in_.res[1], rsp.historyCap * in_.res[0].M);
       in_.count = 2u;

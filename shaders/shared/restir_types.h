@@ -92,7 +92,8 @@ struct RestirParams {
   uint lightCount;
   // Temporal reuse (step 5)
   uint historyValid;        // 1: the history set holds the previous frame's reservoirs
-  uint historySameDomain;   // 1: the history's domain is the current one (still camera and volume)
+  uint historySameDomain;   // 1: the history's domain is the current one (still camera and volume):
+                            // the host dispatches the same-domain temporal pipeline (restir/reuse.glsl)
   float historyCap;         // c: history confidence <= c * M
   float reprojectionDepth;  // world distance along the pixel's ray that is reprojected
   // Spatial reuse (step 6)

@@ -163,6 +163,10 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   };
   candidates_ = make("passes/restir_candidates.comp", "restir candidates", {});
   temporal_ = make("passes/restir_reuse.comp", "restir temporal", {{"PLUME_RS_TEMPORAL", "1"}});
+  // Temporal reuse where the history's domain is the current one (params_.historySameDomain):
+  // the identity shift and stored targets only, no target evaluation compiled in (restir/reuse.glsl).
+  temporalSame_ = make("passes/restir_reuse.comp", "restir temporal (same domain)",
+                       {{"PLUME_RS_TEMPORAL", "1"}, {"PLUME_RS_SAME_DOMAIN", "1"}});
   spatial_ = make("passes/restir_reuse.comp", "restir spatial", {{"PLUME_RS_TEMPORAL", "0"}});
   shade_ = make("passes/restir_shade.comp", "restir shade",
                 tail ? gpu::ShaderDefines{{"PLUME_RS_TAIL", "1"}} : gpu::ShaderDefines{});
@@ -244,7 +248,8 @@ void Restir::setVolumes(const GpuVolumeResources& current, const GpuVolumeResour
 }
 
 std::vector<gpu::ComputePass*> Restir::passes() const {
-  std::vector<gpu::ComputePass*> p = {candidates_.get(), temporal_.get(), spatial_.get(), shade_.get()};
+  std::vector<gpu::ComputePass*> p = {candidates_.get(), temporal_.get(), temporalSame_.get(), spatial_.get(),
+                                      shade_.get()};
   if (tail_) p.push_back(tail_.get());
   return p;
 }
@@ -320,7 +325,7 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
       push.inSet = cur;
       push.historySet = hist;
       push.outSet = out;
-      temporal_->record(cmd, items, &push, &timer_);
+      (params_.historySameDomain != 0u ? temporalSame_ : temporal_)->record(cmd, items, &push, &timer_);
       labels.push_back("temporal");
       gpu::computeBarrier(cmd);
       cur = out;

@@ -104,7 +104,7 @@ class Restir {
   FeatureSet features_;
   std::unique_ptr<GpuEnvironmentMap> envMap_;
   std::unique_ptr<GpuSurfaces> surfaces_;  // only for a scene with surfaces
-  std::unique_ptr<gpu::ComputePass> candidates_, temporal_, spatial_, shade_;
+  std::unique_ptr<gpu::ComputePass> candidates_, temporal_, temporalSame_, spatial_, shade_;
   std::unique_ptr<gpu::ComputePass> tail_;  // final shading's tail (null without one)
   uint32_t tailDispatches_ = 0;             // its dispatches per frame at most (max_bounces' walk)
   gpu::GpuTimer timer_;
