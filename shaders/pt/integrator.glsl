@@ -47,29 +47,39 @@ vec3 pt_direct(PathVertex v, inout RngState rng) {
     GpuLight l = light_at(i);
     vec2 u = vec2(0.0f);
     if (light_samples_direction(l)) u = rng_float2(rng);
+    // The light's sample: direction w, reach dist and its unshadowed term a * b (two factors, in
+    // the order they always multiplied the transmittance). Both kinds of sample end in the one
+    // shadow walk below: a SIMD back end such as lavapipe runs a call site's walk under a mask
+    // even where no lane takes its branch (a second call site for the surfaces' case cost every
+    // medium vertex a masked walk per light).
     vec3 w;
     float dist;
-    vec3 Le;
+    vec3 a;
+    float b = 1.0f;
+    bool lit;
 #ifdef PLUME_HAS_SURFACES
     if (v.kind == VERTEX_SURFACE && l.type == LIGHT_ENVIRONMENT) {
       // A constant environment by the BSDF's own sampling (the medium's is its phase function,
       // which light_sample_dir draws).
       float pdf;
-      vec3 weight = vtx_at_sample(v, u, w, pdf);
-      if (pdf > 0.0f) sum += l.emission * weight * pt_shadow(v, w, DDA_INF, rng);
-      continue;
-    }
+      a = l.emission * vtx_at_sample(v, u, w, pdf);
+      dist = DDA_INF;
+      lit = pdf > 0.0f;
+    } else
 #endif
-    if (!light_connect(l, v.x, light_sample_dir(l, v.x, v.rayDir, frame.g, u), w, dist, Le)) continue;
-    float pdf = light_pdf(l, w, v.rayDir, frame.g);
-    if (!(pdf > 0.0f)) continue;  // (an all-black map)
-    vec3 scatter = vtx_at_scatter(v, w);
-    float mis = 1.0f;
+    {
+      vec3 Le;
+      lit = light_connect(l, v.x, light_sample_dir(l, v.x, v.rayDir, frame.g, u), w, dist, Le);
+      float pdf = lit ? light_pdf(l, w, v.rayDir, frame.g) : 0.0f;
+      lit = lit && pdf > 0.0f;  // (an all-black map)
+      a = Le * vtx_at_scatter(v, w);
+      float mis = 1.0f;
 #ifdef PLUME_HAS_ENV_MAP
-    if (l.type == LIGHT_ENV_MAP) mis = pt_power_heuristic(pdf, vtx_at_pdf(v, w));
+      if (l.type == LIGHT_ENV_MAP) mis = pt_power_heuristic(pdf, vtx_at_pdf(v, w));
 #endif
-    float tr = pt_shadow(v, w, dist, rng);
-    sum += Le * scatter * tr * (mis / pdf);
+      b = mis / pdf;
+    }
+    if (lit) sum += a * pt_shadow(v, w, dist, rng) * b;
   }
 #ifdef PLUME_HAS_EMITTERS
   uvec4 h = rng_next4(rng);
