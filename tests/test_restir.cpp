@@ -19,7 +19,9 @@
 
 #include <glm/glm.hpp>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <random>
 #include <stdexcept>
@@ -314,6 +316,41 @@ TEST_F(GpuRestir, HistoryCapWhileMovingActsOnlyWhenTheCameraMoves) {
   const DifferingPixels d = differingPixels(ctx(), compiler(), tight, loose);
   EXPECT_EQ(d.still, 0u) << "a still camera must keep restir_history_cap";
   EXPECT_GT(d.moving, d.pixels / 4u) << "a moving camera's history must be capped by restir_history_cap_moving";
+}
+
+// A still camera over an unchanged grid dispatches the temporal pipeline compiled for one domain
+// (PLUME_RS_SAME_DOMAIN: the identity shift and the stored targets, no target code; restir/
+// reuse.glsl). It must give the general pipeline's image to rounding, which also checks that the
+// target the general one evaluates is the one the candidates stored (the same function, p̂ of
+// each path in its own pixel); and that image must differ from one without temporal reuse (the
+// history is used at all).
+TEST_F(GpuRestir, SameDomainTemporalPipelineMatchesTheGeneralOne) {
+  RestirOptions same;
+  same.radius = 6;
+  RestirOptions general = same;
+  general.sameDomainTemporal = false;
+  RestirOptions none = same;
+  none.historyCap = 0;
+  auto grid = test::makeNoiseGrid(40, 1.0 / 20, 2);
+  RunSpec spec;
+  spec.runs = 2;
+  spec.framesPerRun = 4;
+  const Scene s = baseScene(16);
+  auto meanOf = [&](const RestirOptions& o) { return runRestir(ctx(), compiler(), s, o, spec, [&](int) { return grid; }).mean; };
+  const Image a = meanOf(same), b = meanOf(general), c = meanOf(none);
+  double worst = 0.0;
+  size_t lit = 0, differ = 0;
+  for (size_t i = 0; i < a.rgb.size(); ++i) {
+    if (!(b.rgb[i] > 0.0f)) continue;
+    ++lit;
+    worst = std::max(worst, std::abs(double(a.rgb[i]) - double(b.rgb[i])) / double(b.rgb[i]));
+    differ += a.rgb[i] != c.rgb[i] ? 1 : 0;
+  }
+  std::printf("[restir] same-domain temporal: worst relative difference %.3g over %zu lit channels, %zu differ "
+              "from no temporal reuse\n", worst, lit, differ);
+  ASSERT_GT(lit, a.rgb.size() / 2) << "too few lit channels to compare";
+  EXPECT_LT(worst, 1e-5) << "the same-domain temporal pipeline must equal the general one to rounding";
+  EXPECT_GT(differ, lit / 2) << "temporal reuse must change the image (the history is used)";
 }
 
 // restir_candidates_moving sets M only in frames whose camera moved since the previous frame:

@@ -325,7 +325,8 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
       push.inSet = cur;
       push.historySet = hist;
       push.outSet = out;
-      (params_.historySameDomain != 0u ? temporalSame_ : temporal_)->record(cmd, items, &push, &timer_);
+      const bool same = params_.historySameDomain != 0u && options_.sameDomainTemporal;
+      (same ? temporalSame_ : temporal_)->record(cmd, items, &push, &timer_);
       labels.push_back("temporal");
       gpu::computeBarrier(cmd);
       cur = out;

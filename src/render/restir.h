@@ -49,6 +49,10 @@ struct RestirOptions {
   // (tests/test_restir_surfaces.cpp, the Jacobian test).
   int fixedNeighbourX = 0;
   int fixedNeighbourY = 0;
+  // Tests only: false dispatches the general temporal pipeline even where the history's domain is
+  // the current one, instead of the one compiled for that case (PLUME_RS_SAME_DOMAIN: identity
+  // shift, stored targets); the two must give one image to rounding (tests/test_restir.cpp).
+  bool sameDomainTemporal = true;
   std::string name() const;  // e.g. "restir pairwise M4 k3 r16 R1 c20" (r: radius in px)
 };
 // From the scene's render settings (render.restir_mis; mode restir-biased's RS_MIS_BIASED is set
