@@ -151,20 +151,48 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
 #endif
   vec4 walk[RS_MAX_VERTICES - 1u];
   uint last = min(first + rsp.walksPerDispatch, M);
-  for (uint m = first; m < last; ++m) {
-    uint uv = rs_pack_uv(rng_float2(rng));  // the sub-pixel position: pdf 1 on the pixel
-    vec3 x = D.origin;
-    vec3 w = rs_domain_dir(D, rs_unpack_uv(uv));
-    vec3 f = vec3(1.0f);  // prefix of f_D with coarse transmittance (the target's)
-    float pdf = 1.0f;     // prefix of the source pdf
-    float t1 = 0.0f;
-    uint keep = 0u;  // vertices of this walk's selected candidate (0: none): copied when the walk ends
-    uint kinds = 0u;  // this walk's vertex kinds so far (RsPathHead.kinds)
-    vec4 slot = vec4(0.0f);  // vertex j's stored coordinates (j >= 2)
+  // One loop over the vertices of the dispatch's walks, one after another: a lane whose walk
+  // ends starts its next one while the others go on (a SIMD back end such as lavapipe runs a
+  // loop while any lane needs it, so walks in a loop nested in the walks' loop cost the longest
+  // walk of the subgroup each). The same draws in the same order as walk by walk.
+  uint m = first;
+  uint j = 0u;  // the vertex the next iteration samples; 0: walk m starts
+  uint uv = 0u;
+  vec3 x = D.origin;
+  vec3 w = vec3(0.0f);
+  vec3 f = vec3(1.0f);  // prefix of f_D with coarse transmittance (the target's)
+  float pdf = 1.0f;     // prefix of the source pdf
+  float t1 = 0.0f;
+  uint keep = 0u;   // vertices of this walk's selected candidate (0: none): copied when the walk ends
+  uint kinds = 0u;  // this walk's vertex kinds so far (RsPathHead.kinds)
+  vec4 slot = vec4(0.0f);  // vertex j's stored coordinates (j >= 2)
 #ifdef PLUME_HAS_SURFACES
-    PathVertex prev = vtx_medium(x, w);  // the vertex that sampled w (the camera's, first)
+  PathVertex prev = vtx_medium(x, vec3(0.0f, 0.0f, 1.0f));  // the vertex that sampled w
 #endif
-    for (uint j = 1u; j <= walkVertices; ++j) {
+  for (;;) {
+    if (j == 0u) {
+      if (m >= last) break;
+      uv = rs_pack_uv(rng_float2(rng));  // the sub-pixel position: pdf 1 on the pixel
+      x = D.origin;
+      w = rs_domain_dir(D, rs_unpack_uv(uv));
+      f = vec3(1.0f);
+      pdf = 1.0f;
+      t1 = 0.0f;
+      keep = 0u;
+      kinds = 0u;
+      slot = vec4(0.0f);
+#ifdef PLUME_HAS_SURFACES
+      prev = vtx_medium(x, w);  // the camera's, first
+#endif
+      j = 1u;
+      if (walkVertices == 0u) {  // no vertices (max_bounces 0): the walk is its draw of (u, v)
+        ++m;
+        j = 0u;
+        continue;
+      }
+    }
+    bool next = false;  // the walk goes on to vertex j + 1 (a `break` below ends it)
+    do {
       float t;
       float sigmaC;
       float tau;
@@ -288,8 +316,15 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
       f *= phase;
 #endif
       w = wNext;
+      next = true;
+    } while (false);
+    if (next && j < walkVertices) {
+      ++j;
+    } else {
+      for (uint i = 0u; i + 2u <= keep; ++i) rsBounces[base + i] = walk[i];
+      ++m;
+      j = 0u;
     }
-    for (uint i = 0u; i + 2u <= keep; ++i) rsBounces[base + i] = walk[i];
   }
   if (last < M) {
     rsOutput[rs_state_slot(pixelIndex)] = vec4(r.w_sum, r.p_hat, uintBitsToFloat(rng.counter), 0.0f);
