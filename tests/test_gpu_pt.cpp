@@ -149,9 +149,9 @@ TEST_F(GpuPathTracer, FeatureSetsCompileDifferentVariantsAndBothMatch) {
   renderAndCompare(ctx(), compiler(), multi, grid, 512, 1024, "variant_multi", &v2);
   EXPECT_EQ(v1, "sun");
   EXPECT_EQ(v2, "sun+env+multi");
-  // Each path tracer compiles its four kernels: extension and shading for its feature set, and
-  // the feature-independent queue and resolve kernels.
-  EXPECT_EQ(compiler().compiles() - compilesBefore, 8u);
+  // Each path tracer compiles its five kernels: camera rays, extension and shading for its
+  // feature set, and the feature-independent queue and resolve kernels.
+  EXPECT_EQ(compiler().compiles() - compilesBefore, 10u);
   EXPECT_NE(featuresOf(single).defines(), featuresOf(multi).defines());
 }
 

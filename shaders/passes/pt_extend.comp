@@ -1,6 +1,6 @@
-// The path tracer's extension kernel (pt/wavefront.glsl): every queued path — or, for the
-// generation's first dispatch, every slot's camera ray — to its next real collision; the collided
-// ones are queued for shading.
+// The path tracer's extension kernel (pt/wavefront.glsl): every queued path (the camera rays
+// pt_camera.comp queued, or the rays pt_shade.comp drew) to its next real collision; the
+// collided ones are queued for shading.
 #version 450
 #extension GL_GOOGLE_include_directive : require
 
@@ -19,10 +19,9 @@ void main() {
   vol_load_params();
   scene_load_params();
   uint i = gl_GlobalInvocationID.x;
-  bool camera = ptPush.firstExtend != 0u;
-  bool live = i < (camera ? ptPush.slots : wave.extendArgs.w);
-  uint slot = live ? (camera ? i : ptQueues[i]) : 0u;
-  bool collided = live && pt_extend(slot, camera);
+  bool live = i < wave.extendArgs.w;
+  uint slot = live ? ptQueues[i] : 0u;
+  bool collided = live && pt_extend(slot, ptPush.cameraRays != 0u);
   pt_enqueue(PT_TO_SHADE, slot, collided);
   loop_guard_check(frame.loopProbe);
 }

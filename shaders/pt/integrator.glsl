@@ -120,21 +120,44 @@ vec3 pt_escaped_map(vec3 dir, float phasePdf) {
 #define PT_FOLLOWS_PHASE 1
 #endif
 
-// Extension (pt_extend.comp): the path in `slot` (a camera ray where `camera`) to its next
-// vertex: the medium's real collision by delta tracking (gathering its emission on the way), or
-// the first surface if that is nearer (the medium is tracked only up to it; an emissive surface
-// adds what it emits towards the path). True where the path found a vertex within max_bounces
-// and waits for shading there; otherwise it is finished (escaped, with the environment it sees,
-// or past max_bounces) and its radiance is final.
+// The camera ray of the path in `slot`: its first two draws (a box filter over the pixel, row 0
+// at the top: DESIGN §2).
+vec3 pt_camera_ray(uint slot, inout RngState rng) {
+  uvec2 pixel;
+  pt_slot_sample(slot, pixel);
+  return normalize(cam_direction(vec2(pixel) + rng_float2(rng), frame.size, frame.camera));
+}
+
+// The camera kernel (pt_camera.comp): true where the path in `slot`'s camera ray may meet the
+// scene, for extension to follow it; a ray that certainly meets nothing (no surfaces, and the
+// volume's box, where the density may be non-zero, missed: vol_may_meet) is finished here with
+// the environment it sees, as extension would finish it. On a SIMD back end a camera ray that
+// misses still costs its subgroup one masked pass of the whole walk, so culling those rays keeps
+// extension's lanes on rays that walk (the bundled smoke: ~60% of the camera rays miss;
+// notes/bench/kernels.md "Session 24").
+bool pt_camera(uint slot) {
+  RngState rng = pt_slot_rng(slot, 0u);
+  vec3 dir = pt_camera_ray(slot, rng);
+#ifdef PLUME_HAS_SURFACES
+  return true;
+#else
+  if (vol_may_meet(frame.camera.position, dir)) return true;
+  ptPaths[slot].radiance = light_escaped(dir);
+  return false;
+#endif
+}
+
+// Extension (pt_extend.comp): the path in `slot` (a camera ray where `camera`: the slots
+// pt_camera queued) to its next vertex: the medium's real collision by delta tracking (gathering
+// its emission on the way), or the first surface if that is nearer (the medium is tracked only
+// up to it; an emissive surface adds what it emits towards the path). True where the path found
+// a vertex within max_bounces and waits for shading there; otherwise it is finished (escaped,
+// with the environment it sees, or past max_bounces) and its radiance is final.
 bool pt_extend(uint slot, bool camera) {
   PtPath p;
   RngState rng = pt_slot_rng(slot, 0u);
   if (camera) {
-    uvec2 pixel;
-    pt_slot_sample(slot, pixel);
-    vec2 u = rng_float2(rng);
-    // Box filter, row 0 at the top (DESIGN §2).
-    p.dir = normalize(cam_direction(vec2(pixel) + u, frame.size, frame.camera));
+    p.dir = pt_camera_ray(slot, rng);
     p.origin = frame.camera.position;
     p.phasePdf = 0.0f;
     p.scatterings = 0u;

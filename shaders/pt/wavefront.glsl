@@ -1,5 +1,6 @@
 // The wavefront path tracer's state (DESIGN §4.1; render/path_tracer.cpp drives it): a generation
 // of path slots (shared/pt_wave.h), each slot's path between its kernels, and the two queues.
+// pt_camera.comp makes every slot's camera ray and queues those that may meet the scene;
 // pt_extend.comp takes every queued path to its next real collision or out of the volume;
 // pt_shade.comp estimates next-event transmittance at the collided ones, then rolls the roulette
 // and samples the phase function; pt_queue.comp turns one kernel's output queue into the other's

@@ -27,7 +27,7 @@ struct PtWave {
 
 // Push constants of every wavefront kernel (one layout for all).
 struct PtPush {
-  uint firstExtend;  // pt_extend: 1 = the generation's camera rays (slot = invocation, no queue)
+  uint cameraRays;   // pt_extend: 1 = the generation's first extension (the queued camera rays)
   uint pixelBegin;   // the generation's first pixel (row-major)
   uint pixelCount;   // its pixels
   uint sampleBase;   // the sample of its slot 0, counted from frame.firstSample

@@ -82,6 +82,22 @@ bool vol_clip_to_bounds(vec3 lo, vec3 hi, vec3 o, vec3 d, float tMax, out float 
   return t0 < t1;
 }
 
+// Whether a walk along the world ray (xWorld, wWorld) through the current volume may meet any
+// density: false only where the ray misses the bounds of vol_clip_to_bounds grown by
+// VOL_MEET_MARGIN index units (far above any rounding of the ray's transform in another
+// kernel), so a ray it rejects is one every walk rejects. Lets a kernel cull rays before the
+// walks' kernels (pt_camera).
+const float VOL_MEET_MARGIN = 0.01f;
+bool vol_may_meet(vec3 xWorld, vec3 wWorld) {
+  vec3 o;
+  vec3 d;
+  vol_ray_to_index(VOL_CURRENT, xWorld, wWorld, o, d);
+  float t0;
+  float t1;
+  return vol.empty == 0 && vol_clip_to_bounds(vol.boundsMin - VOL_MEET_MARGIN, vol.boundsMax + VOL_MEET_MARGIN, o, d,
+                                               DDA_INF, t0, t1);
+}
+
 bool vol_walk_start(uint field, uint v, vec3 o, vec3 d, float tMax, out VolWalk w) {
   w.innerLive = false;
   w.v = v;

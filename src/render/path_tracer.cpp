@@ -19,7 +19,7 @@ constexpr uint32_t kBouncesPerSubmit = 16;  // extension + shading rounds record
 
 PathTracer::PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene, bool kernelCounters)
     : ctx_(ctx), scene_(scene), features_(featuresOf(scene)), compiler_(compiler),
-      timer_(ctx, 2 * kBouncesPerSubmit) {
+      timer_(ctx, 2 * kBouncesPerSubmit + 1) {
   features_.kernelCounters = kernelCounters;
   envMap_ = std::make_unique<GpuEnvironmentMap>(ctx, scene);
   if (features_.surfaces) {
@@ -83,6 +83,7 @@ PathTracer::Tracking& PathTracer::tracking(bool skipEmpty) {
   gpu::ShaderDefines defines = features_.defines();
   if (skipEmpty) defines.emplace_back("PLUME_SKIP_EMPTY", "1");
   const std::string variant = "[" + features_.name() + (skipEmpty ? "+skip" : "") + "]";
+  t.camera = makePass("passes/pt_camera.comp", defines, "pt camera " + variant, true);
   t.extend = makePass("passes/pt_extend.comp", defines, "pt extend " + variant, true);
   t.shade = makePass("passes/pt_shade.comp", defines, "pt shade " + variant, true);
   return t;
@@ -97,6 +98,7 @@ void PathTracer::setVolume(const GpuVolumeResources& volume) {
   const int widest = std::max(p.brickDims.x, std::max(p.brickDims.y, p.brickDims.z));
   skipEmpty_ = p.levelCount >= 2u && widest > 16;
   active_ = &tracking(skipEmpty_);
+  volume.bind(active_->camera->set);
   volume.bind(active_->extend->set);
   volume.bind(active_->shade->set);
 }
@@ -123,7 +125,6 @@ void PathTracer::addTimes() {
 // extensions: a path ends at its (max_bounces + 1)-th collision). Then its samples are merged.
 void PathTracer::traceGeneration(uint32_t pixelBegin, uint32_t pixels, uint32_t sampleBase, uint32_t samples) {
   shared::PtPush push{};
-  push.firstExtend = 1u;
   push.pixelBegin = pixelBegin;
   push.pixelCount = pixels;
   push.sampleBase = sampleBase;
@@ -137,15 +138,21 @@ void PathTracer::traceGeneration(uint32_t pixelBegin, uint32_t pixels, uint32_t 
   for (uint64_t extensions = 0;;) {
     ctx_.submitAndWait([&](VkCommandBuffer cmd) {
       timer_.reset(cmd);
+      if (extensions == 0) {
+        // The camera rays: those that may meet the scene are queued for the first extension.
+        const uint32_t scope = timer_.begin(cmd, active_->camera->pipeline.name());
+        active_->camera->record(cmd, glm::uvec3(push.slots, 1, 1), &push);
+        gpu::computeBarrier(cmd);
+        push.stage = shared::PT_QUEUE_TO_EXTEND;
+        queue_->record(cmd, glm::uvec3(1), &push);
+        timer_.end(cmd, scope);
+        gpu::computeBarrier(cmd);
+      }
       for (uint32_t round = 0; round < kBouncesPerSubmit && extensions < maxExtensions; ++round, ++extensions) {
         // Each kernel is timed with the queue kernel that follows it.
         uint32_t scope = timer_.begin(cmd, active_->extend->pipeline.name());
-        if (push.firstExtend) {
-          active_->extend->record(cmd, glm::uvec3(push.slots, 1, 1), &push);
-        } else {
-          active_->extend->recordIndirect(cmd, wave_, kExtendArgs, &push);
-        }
-        push.firstExtend = 0u;
+        push.cameraRays = extensions == 0 ? 1u : 0u;
+        active_->extend->recordIndirect(cmd, wave_, kExtendArgs, &push);
         gpu::computeBarrier(cmd);
         push.stage = shared::PT_QUEUE_TO_SHADE;
         queue_->record(cmd, glm::uvec3(1), &push);

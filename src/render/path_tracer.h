@@ -59,7 +59,7 @@ class PathTracer {
   std::unique_ptr<GpuEnvironmentMap> envMap_;
   std::unique_ptr<GpuSurfaces> surfaces_;  // only for a scene with surfaces
   struct Tracking {  // the kernels that walk the volume, per variant
-    std::unique_ptr<gpu::ComputePass> extend, shade;
+    std::unique_ptr<gpu::ComputePass> camera, extend, shade;
   };
   Tracking& tracking(bool skipEmpty);
   gpu::BindingTypes volumeTypes() const;
