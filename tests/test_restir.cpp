@@ -9,6 +9,8 @@
 // spatial reuse correlates the pixels of a run.
 #include "media/vdb_loader.h"
 #include "reference/reference.h"
+#include "render/gpu_scene.h"
+#include "render/pixel_order.h"
 #include "render/restir.h"
 #include "support/gpu_fixture.h"
 #include "support/grids.h"
@@ -351,6 +353,76 @@ TEST_F(GpuRestir, SameDomainTemporalPipelineMatchesTheGeneralOne) {
   ASSERT_GT(lit, a.rgb.size() / 2) << "too few lit channels to compare";
   EXPECT_LT(worst, 1e-5) << "the same-domain temporal pipeline must equal the general one to rounding";
   EXPECT_GT(differ, lit / 2) << "temporal reuse must change the image (the history is used)";
+}
+
+// The pixels whose camera rays miss the volume run through the passes' variants without walks
+// (PLUME_RS_OUTSIDE; render/pixel_order.h), the others through the walking pipelines: the frames
+// must be those of the walking pipelines over every pixel, bit for bit — a still and a moving
+// camera, an animated grid (the history's volume differs), the generalised balance heuristic, and
+// final shading's tail — and the split must be real (pixels on both sides).
+TEST_F(GpuRestir, PixelsThatMissTheVolumeSkipTheWalksAndKeepTheImage) {
+  Scene still = baseScene(24);
+  still.camera.base.position = {1.0f, 1.2f, 7.5f};  // the grid's box covers part of the image
+  Scene moving = still;
+  CameraKey key;
+  key.frame = 4;
+  key.pose = still.camera.base;
+  key.pose.position = {2.4f, 1.6f, 7.0f};
+  moving.camera.keys.push_back(key);
+  auto gridAt = [](int frame) { return test::makeNoiseGrid(40, 1.0 / 20, unsigned(10 + frame)); };
+  struct Case {
+    const char* name;
+    const Scene* scene;
+    bool animated;
+    int maxBounces;
+    int prefix;
+    uint32_t mis;
+  };
+  const Case cases[] = {{"still camera", &still, false, 1, 16, shared::RS_MIS_PAIRWISE},
+                        {"moving camera", &moving, false, 1, 16, shared::RS_MIS_PAIRWISE},
+                        {"moving camera, animated grid, tail", &moving, true, 3, 1, shared::RS_MIS_PAIRWISE},
+                        {"moving camera, gbh", &moving, false, 2, 16, shared::RS_MIS_GBH}};
+  for (const Case& c : cases) {
+    Scene s = *c.scene;
+    s.render.maxBounces = c.maxBounces;
+    std::vector<std::unique_ptr<GpuVolumeResources>> volumes;  // one per frame, or one for all
+    for (int f = 1; f <= (c.animated ? 4 : 1); ++f) {
+      volumes.push_back(std::make_unique<GpuVolumeResources>(ctx(), *bakeOf(gridAt(f)), s.media[0].densityScale));
+    }
+    auto frames = [&](bool cull) {
+      RestirOptions o;
+      o.radius = 6;
+      o.mis = c.mis;
+      o.prefix = c.prefix;
+      o.cullOutside = cull;
+      Restir restir(ctx(), compiler(), s, o);
+      std::vector<Image> out;
+      for (int f = 1; f <= 4; ++f) {
+        const size_t cur = c.animated ? size_t(f - 1) : 0, prev = c.animated ? size_t(std::max(f - 2, 0)) : 0;
+        restir.setVolumes(*volumes[cur], *volumes[prev]);
+        out.push_back(restir.renderFrame(f, 1));
+      }
+      return out;
+    };
+    const std::vector<Image> culled = frames(true), walked = frames(false);
+    size_t differ = 0, lit = 0;
+    for (size_t f = 0; f < culled.size(); ++f) {
+      for (size_t i = 0; i < culled[f].rgb.size(); ++i) {
+        differ += culled[f].rgb[i] != walked[f].rgb[i] ? 1 : 0;
+        lit += walked[f].rgb[i] > 0.0f ? 1 : 0;
+      }
+    }
+    // The split the last frame used: the frame's camera over its volume's box.
+    const shared::GpuVolume& v = volumes.back()->params();
+    const PixelOrder order = volumePixelOrder(gpuCamera(s.camera, 4), s.camera.width, s.camera.height,
+                                              v.boundsMin, v.boundsMax, v.indexToWorld, v.empty != 0);
+    std::printf("[restir] outside variants, %s: %u of %zu pixels may see the volume; %zu of %zu channels differ\n",
+                c.name, order.inside, order.pixels.size(), differ, lit);
+    EXPECT_EQ(differ, 0u) << c.name << ": the outside variants must not change any pixel";
+    EXPECT_GT(order.inside, order.pixels.size() / 10) << c.name;
+    EXPECT_LT(order.inside, order.pixels.size() * 9 / 10) << c.name;
+    EXPECT_GT(lit, culled.size() * culled[0].rgb.size() / 2) << c.name << ": too few lit channels";
+  }
 }
 
 // restir_candidates_moving sets M only in frames whose camera moved since the previous frame:

@@ -5,7 +5,7 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 
-layout(local_size_x = 8, local_size_y = 8) in;
+layout(local_size_x = 64) in;  // over a list of pixels (rs_dispatch_pixel)
 
 #include "../restir/bindings.glsl"
 #include "../restir/bridge.glsl"
@@ -20,8 +20,8 @@ layout(local_size_x = 8, local_size_y = 8) in;
 // pipeline holds only its own code (see restir/reuse.glsl on PLUME_RS_MIS).
 void main() {
   rs_load_params();
-  uvec2 pixel = gl_GlobalInvocationID.xy;
-  if (pixel.x >= frame.size.x || pixel.y >= frame.size.y) return;
+  uvec2 pixel;
+  if (!rs_dispatch_pixel(pixel)) return;
   rs_reuse_pixel(pixel, pixel.y * frame.size.x + pixel.x, PLUME_RS_TEMPORAL != 0, push.spatialRound, push.inSet,
                  push.historySet, push.outSet);
   loop_guard_check(frame.loopProbe);

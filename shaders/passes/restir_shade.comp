@@ -3,7 +3,7 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 
-layout(local_size_x = 8, local_size_y = 8) in;
+layout(local_size_x = 64) in;  // over a list of pixels (rs_dispatch_pixel)
 
 #include "../restir/bindings.glsl"
 #include "../restir/bridge.glsl"
@@ -12,8 +12,8 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 void main() {
   rs_load_params();
-  uvec2 pixel = gl_GlobalInvocationID.xy;
-  if (pixel.x >= frame.size.x || pixel.y >= frame.size.y) return;
+  uvec2 pixel;
+  if (!rs_dispatch_pixel(pixel)) return;
   rs_shade_pixel(pixel, push.inSet, push.restartAccumulation != 0u);
   loop_guard_check(frame.loopProbe);
 }

@@ -5,7 +5,7 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 
-layout(local_size_x = 8, local_size_y = 8) in;
+layout(local_size_x = 64) in;  // over a list of pixels (rs_dispatch_pixel)
 
 #define PLUME_RS_TAIL 1
 #include "../restir/bindings.glsl"
@@ -15,8 +15,8 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 void main() {
   rs_load_params();
-  uvec2 pixel = gl_GlobalInvocationID.xy;
-  if (pixel.x >= frame.size.x || pixel.y >= frame.size.y) return;
+  uvec2 pixel;
+  if (!rs_dispatch_pixel(pixel)) return;
   bool alive = rs_tail_pixel(pixel, push.restartAccumulation != 0u);
   if (alive && push.countAlive != 0u) atomicAdd(rsCounters[RS_COUNTER_TAIL_ALIVE], 1u);
   loop_guard_check(frame.loopProbe);

@@ -19,7 +19,12 @@
 #include "../surface/surfaces.glsl"
 #endif
 
-layout(std430, binding = BIND_RS_PARAMS) readonly buffer RestirParamBuffer { RestirParams rsParams; };
+// The parameters, then the frame's pixels in the order its passes take them (render/pixel_order.h:
+// packed x | y << 16; first those whose camera rays may meet the volume, then the others).
+layout(std430, binding = BIND_RS_PARAMS) readonly buffer RestirParamBuffer {
+  RestirParams rsParams;
+  uint rsPixels[];
+};
 RestirParams rsp;  // a private copy (volume/bindings.glsl says why), loaded by rs_load_params()
 // Reservoir sets: [set * pixels + pixel].
 layout(std430, binding = BIND_RS_RESERVOIRS) buffer ReservoirBuffer { RsPacked rsReservoirs[]; };
@@ -35,6 +40,15 @@ layout(std430, binding = BIND_RS_OUTPUT) buffer OutputBuffer { vec4 rsOutput[]; 
 layout(std430, binding = BIND_RS_COUNTERS) buffer RestirCounterBuffer { uint rsCounters[]; };
 
 layout(push_constant) uniform PushBlock { RsPush push; };
+
+// The pixel of this invocation of a dispatch over rsPixels[push.listBegin ..][.. push.listCount]
+// (one-dimensional workgroups); false past the list's end.
+bool rs_dispatch_pixel(out uvec2 pixel) {
+  uint i = gl_GlobalInvocationID.x;
+  uint packed = i < push.listCount ? rsPixels[push.listBegin + i] : 0u;
+  pixel = uvec2(packed & 0xffffu, packed >> 16u);
+  return i < push.listCount;
+}
 
 // The private copies of every parameter block: first thing in every ReSTIR kernel.
 void rs_load_params() {

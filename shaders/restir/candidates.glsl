@@ -30,6 +30,10 @@
 #ifndef PLUME_RESTIR_CANDIDATES_GLSL
 #define PLUME_RESTIR_CANDIDATES_GLSL
 
+#if defined(PLUME_RS_OUTSIDE) && defined(PLUME_HAS_SURFACES)
+#error "PLUME_RS_OUTSIDE: a camera ray may meet a surface anywhere"
+#endif
+
 // The head of the path a candidate ending at vertex j of a walk stands for (vertices 2..j are the
 // walk's, copied when the walk ends).
 RsPathHead rs_candidate_head(uint uv, float t1, uint j, uint kinds, uint light, vec2 ls, uint prim) {
@@ -127,6 +131,13 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
 #else
   uint walkVertices = maxVertices;
 #endif
+#ifdef PLUME_RS_OUTSIDE
+  // The variant for pixels whose camera rays miss the volume (render/pixel_order.h; scenes
+  // without surfaces): each walk ends before its first vertex, so the reservoir is empty with
+  // confidence M, as the walking variant finds there, and no walk's code is compiled in (a SIMD
+  // back end such as lavapipe runs it under a mask otherwise). All M walks in one dispatch.
+  walkVertices = 0u;
+#endif
   float q = min(1.0f, plume_max3(vtx_albedo(VERTEX_MEDIUM)));
   uint base = rs_bounce_base(outSet, pixelIndex);
   RsReservoir r = rs_empty();
@@ -150,7 +161,11 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
   if (first == 0u) rs_lamp_reservoir(D, pixelIndex, rng);
 #endif
   vec4 walk[RS_MAX_VERTICES - 1u];
+#ifdef PLUME_RS_OUTSIDE
+  uint last = M;
+#else
   uint last = min(first + rsp.walksPerDispatch, M);
+#endif
   // One loop over the vertices of the dispatch's walks, one after another: a lane whose walk
   // ends starts its next one while the others go on (a SIMD back end such as lavapipe runs a
   // loop while any lane needs it, so walks in a loop nested in the walks' loop cost the longest

@@ -74,13 +74,20 @@ uvec2 rs_pair(uint t, uint count) {
 
 bool rs_has_sample(uint s) { return (in_.hasSample & (1u << s)) != 0u; }
 
+// PLUME_RS_OUTSIDE: the variant for pixels whose camera rays miss the volume (render/
+// pixel_order.h; scenes without surfaces). Its canonical input never holds a path (candidates
+// find none, and no shifted path has density at its first vertex there), and every target in
+// its domain is 0 for the same reason, so the variant evaluates none: the weights see the zeros
+// the walking variant computes, and the confidences add up as there.
 void rs_cross_targets() {
 #if !PLUME_RS_SAME_DOMAIN
   uint pairs = rs_pair_count(in_.count);
   for (uint t = 0u; t < pairs; ++t) {
     uvec2 sj = rs_pair(t, in_.count);
     float v = 0.0f;
+#ifndef PLUME_RS_OUTSIDE
     if (rs_has_sample(sj.x)) v = rs_target(rs_input_domain(sj.y), rs_input_set(sj.x), in_.pixel[sj.x]);
+#endif
     rsCross[sj.x * RS_MAX_INPUTS + sj.y] = v;
   }
 #endif

@@ -197,11 +197,23 @@ void rs_shade_pixel(uvec2 pixel, uint set, bool restart) {
   uint index = pixel.y * frame.size.x + pixel.x;
   RsDomain D = rs_current_domain(pixel);
   RngState rng = rs_shading_rng(pixel);
+#ifdef PLUME_RS_OUTSIDE
+  // The variant for pixels whose camera rays miss the volume (render/pixel_order.h; scenes
+  // without surfaces): their reservoirs are empty (restir/candidates.glsl, reuse.glsl), the camera
+  // ray escapes with transmittance 1 and meets no emission, and the tail's first segment ends
+  // it: the sample is the environment along the same ray rs_shade draws.
+  vec3 L = vec3(0.0f);
+#ifdef PLUME_HAS_ENV
+  L += light_escaped(rs_domain_dir(D, rng_float2(rng)));
+#endif
+  rs_accumulate(index, L, restart);
+#else
   vec3 L = rs_shade(D, index, set, rng);
 #ifdef PLUME_RS_TAIL
   rs_tail_store(index, rs_tail_start(D, L, rng));
 #else
   rs_accumulate(index, L, restart);
+#endif
 #endif
 }
 

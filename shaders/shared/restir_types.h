@@ -126,6 +126,8 @@ struct RsPush {
   uint restartAccumulation;  // final shading: 1 restarts the accumulation, 0 adds to it
   uint candidate;            // candidates: the first walk m < M of this dispatch
   uint countAlive;           // tail: 1 counts the walks still alive after this dispatch
+  uint listBegin;            // the dispatch's pixels: rsPixels[listBegin .. listBegin + listCount)
+  uint listCount;            //   (restir/bindings.glsl rs_dispatch_pixel)
   uint pad2;
 };
 
@@ -178,7 +180,7 @@ static_assert(sizeof(plume::shared::RsPathHead) == 32, "RsPathHead crosses the b
 static_assert(offsetof(plume::shared::RsPathHead, vertexCount) == 12, "RsPathHead layout");
 static_assert(offsetof(plume::shared::RestirParams, candidates) == 64, "RestirParams layout");
 static_assert(sizeof(plume::shared::RestirParams) == 64 + 5 * 16, "RestirParams layout");
-static_assert(sizeof(plume::shared::RsPush) == 32, "RsPush layout");
+static_assert(sizeof(plume::shared::RsPush) == 40, "RsPush layout");
 #endif
 
 #endif

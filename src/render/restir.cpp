@@ -159,7 +159,7 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
     if (features_.surfaces && options_.reconnect) d.emplace_back("PLUME_RS_RECONNECT", "1");
     d.insert(d.end(), extra.begin(), extra.end());
     return std::make_unique<gpu::ComputePass>(ctx, compiler.compile(file, d), bindings,
-                                              uint32_t(sizeof(shared::RsPush)), name + variant, glm::uvec3(8, 8, 1));
+                                              uint32_t(sizeof(shared::RsPush)), name + variant, glm::uvec3(64, 1, 1));
   };
   candidates_ = make("passes/restir_candidates.comp", "restir candidates", {});
   temporal_ = make("passes/restir_reuse.comp", "restir temporal", {{"PLUME_RS_TEMPORAL", "1"}});
@@ -170,6 +170,19 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   spatial_ = make("passes/restir_reuse.comp", "restir spatial", {{"PLUME_RS_TEMPORAL", "0"}});
   shade_ = make("passes/restir_shade.comp", "restir shade",
                 tail ? gpu::ShaderDefines{{"PLUME_RS_TAIL", "1"}} : gpu::ShaderDefines{});
+  // The pixels whose camera rays miss the volume go through variants without walks (their
+  // reservoirs stay empty and their targets are 0; render/pixel_order.h): on lavapipe a walk's
+  // code costs a subgroup its masked pass even where no lane walks (the bundled smoke: ~60% of
+  // the pixels, ~35% of an iteration; notes/restir.md "Session 24"). Not with surfaces, which a
+  // camera ray may meet anywhere.
+  if (!features_.surfaces && options_.cullOutside) {
+    const gpu::ShaderDefines out = {{"PLUME_RS_OUTSIDE", "1"}};
+    candidatesOut_ = make("passes/restir_candidates.comp", "restir candidates (outside)", out);
+    temporalOut_ = make("passes/restir_reuse.comp", "restir temporal (outside)", {{"PLUME_RS_TEMPORAL", "1"}, out[0]});
+    spatialOut_ = make("passes/restir_reuse.comp", "restir spatial (outside)", {{"PLUME_RS_TEMPORAL", "0"}, out[0]});
+    shadeOut_ = make("passes/restir_shade.comp", "restir shade (outside)",
+                     tail ? gpu::ShaderDefines{{"PLUME_RS_TAIL", "1"}, out[0]} : out);
+  }
   // The tail's walk goes on in dispatches of at most RS_TAIL_SEGMENTS segments each (lavapipe's
   // loop budget, docs/architecture.md): enough of them for the longest walk, max_bounces
   // segments (one more in an emitting medium).
@@ -187,7 +200,9 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   lightBuffer_ = lightTexels(ctx, lights);
   const size_t choices = std::max(lights.size(), scene.lights.size() + (features_.emitters ? 1 : 0));
   lightChoice_ = gpu::Buffer(ctx, choices * sizeof(shared::GpuLightChoice), storage, "light choice");
-  paramBuffer_ = gpu::Buffer(ctx, sizeof(shared::RestirParams), storage, "restir parameters");
+  // The parameters, then the frame's pixels in the passes' order (restir/bindings.glsl rsPixels).
+  paramBuffer_ = gpu::Buffer(ctx, sizeof(shared::RestirParams) + pixels * sizeof(uint32_t), storage,
+                             "restir parameters");
   reservoirs_ = gpu::Buffer(ctx, kSets * pixels * sizeof(shared::RsPacked), storage, "reservoirs");
   paths_ = gpu::Buffer(ctx, kSets * pixels * sizeof(shared::RsPathHead), storage, "reservoir paths");
   bounces_ = gpu::Buffer(ctx, kSets * pixels * stride * sizeof(glm::vec4), storage, "reservoir path vertices");
@@ -239,6 +254,7 @@ void Restir::setVolumes(const GpuVolumeResources& current, const GpuVolumeResour
   // Reprojection depth: the distance from the camera to the volume's centre (a per-frame
   // constant, so the history pixel never depends on a sample).
   const shared::GpuVolume& v = current.params();
+  volume_ = v;
   const glm::vec3 centre = glm::vec3(v.indexToWorld * glm::vec4(0.5f * (v.boundsMin + v.boundsMax), 1.0f));
   centre_ = centre;
   currentSerial_ = current.serial();
@@ -250,7 +266,9 @@ void Restir::setVolumes(const GpuVolumeResources& current, const GpuVolumeResour
 std::vector<gpu::ComputePass*> Restir::passes() const {
   std::vector<gpu::ComputePass*> p = {candidates_.get(), temporal_.get(), temporalSame_.get(), spatial_.get(),
                                       shade_.get()};
-  if (tail_) p.push_back(tail_.get());
+  for (gpu::ComputePass* q : {candidatesOut_.get(), temporalOut_.get(), spatialOut_.get(), shadeOut_.get(), tail_.get()}) {
+    if (q) p.push_back(q);
+  }
   return p;
 }
 
@@ -283,6 +301,18 @@ void Restir::fillFrame(int frame, uint32_t sequence, uint32_t key) {
   params_.reprojectionDepth = glm::length(centre_ - cam.position);
   frameBuffer_.upload(&frame_, sizeof(frame_));
   paramBuffer_.upload(&params_, sizeof(params_));
+  // The pixels in the passes' order: those whose rays may meet the volume first, where the
+  // outside variants exist (otherwise all of them count as inside).
+  if (pixelOrder_.pixels.empty() || !sameCamera(orderCam_, cam) || orderSerial_ != currentSerial_) {
+    const int w = scene_.camera.width, h = scene_.camera.height;
+    pixelOrder_ = candidatesOut_ ? volumePixelOrder(cam, w, h, volume_.boundsMin, volume_.boundsMax,
+                                                    volume_.indexToWorld, volume_.empty != 0)
+                                 : allPixels(w, h);
+    paramBuffer_.upload(pixelOrder_.pixels.data(), pixelOrder_.pixels.size() * sizeof(uint32_t),
+                        sizeof(shared::RestirParams));
+    orderCam_ = cam;
+    orderSerial_ = currentSerial_;
+  }
   prevCam_ = cam;
 }
 
@@ -298,7 +328,6 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
   const uint32_t key = uint32_t(frame) * kMaxIterations + iteration;
   fillFrame(frame, sequence, key);
   const bool temporal = params_.historyValid != 0u;
-  const glm::uvec3 items(uint32_t(scene_.camera.width), uint32_t(scene_.camera.height), 1u);
   std::vector<std::string> labels;
   uint32_t finalSet = 0;
   uint32_t tailDispatched = 0;
@@ -310,13 +339,31 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
     uint32_t cur = (hist + 1) % kSets;
     shared::RsPush push{};
     push.outSet = cur;
-    // walksPerDispatch candidate walks per dispatch (lavapipe's loop budget: restir/candidates.glsl).
+    // A pass over the frame's pixels: the walking pipeline over those that may see the volume
+    // (the first pixelOrder_.inside of the list), its variant without walks over the others.
+    const uint32_t all = uint32_t(pixelOrder_.pixels.size()), inside = pixelOrder_.inside;
+    auto over = [&](const gpu::ComputePass& pass, shared::RsPush p, uint32_t begin, uint32_t count) {
+      if (count == 0) return;
+      p.listBegin = begin;
+      p.listCount = count;
+      pass.record(cmd, glm::uvec3(count, 1, 1), &p);
+    };
+    auto both = [&](const gpu::ComputePass& walking, const gpu::ComputePass* outside, const char* label) {
+      const uint32_t scope = timer_.begin(cmd, label);
+      over(walking, push, 0, outside ? inside : all);
+      if (outside) over(*outside, push, inside, all - inside);
+      timer_.end(cmd, scope);
+    };
+    // walksPerDispatch candidate walks per dispatch (lavapipe's loop budget: restir/candidates.glsl);
+    // the outside variant's M walks (none of them reaches a vertex) in one.
     const uint32_t candidates = timer_.begin(cmd, "restir candidates");
     for (uint32_t m = 0; m < params_.candidates; m += params_.walksPerDispatch) {
       if (m > 0) gpu::computeBarrier(cmd);
       push.candidate = m;
-      candidates_->record(cmd, items, &push);
+      over(*candidates_, push, 0, candidatesOut_ ? inside : all);
     }
+    push.candidate = 0;
+    if (candidatesOut_) over(*candidatesOut_, push, inside, all - inside);
     timer_.end(cmd, candidates);
     labels.push_back("candidates");
     gpu::computeBarrier(cmd);
@@ -326,7 +373,12 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
       push.historySet = hist;
       push.outSet = out;
       const bool same = params_.historySameDomain != 0u && options_.sameDomainTemporal;
-      (same ? temporalSame_ : temporal_)->record(cmd, items, &push, &timer_);
+      // The same-domain pipeline evaluates no target: one dispatch over every pixel.
+      if (same) {
+        both(*temporalSame_, nullptr, "restir temporal");
+      } else {
+        both(*temporal_, temporalOut_.get(), "restir temporal");
+      }
       labels.push_back("temporal");
       gpu::computeBarrier(cmd);
       cur = out;
@@ -337,7 +389,7 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
       push.historySet = cur;
       push.outSet = out;
       push.spatialRound = uint32_t(r);
-      spatial_->record(cmd, items, &push, &timer_);
+      both(*spatial_, spatialOut_.get(), "restir spatial");
       labels.push_back(strf("spatial %d", r + 1));
       gpu::computeBarrier(cmd);
       cur = out;
@@ -347,7 +399,7 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
     push.outSet = cur;
     push.spatialRound = 0u;
     push.restartAccumulation = accumulate ? 0u : 1u;
-    shade_->record(cmd, items, &push, &timer_);
+    both(*shade_, shadeOut_.get(), "restir shade");
     labels.push_back("shade");
     tailPush = push;
     if (tail_) tailDispatched = recordTail(cmd, push, 0);
@@ -376,13 +428,17 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
 // last one counting the walks still alive after it (rsCounters[RS_COUNTER_TAIL_ALIVE]); returns
 // the number dispatched so far.
 uint32_t Restir::recordTail(VkCommandBuffer cmd, shared::RsPush push, uint32_t first) {
-  const glm::uvec3 items(uint32_t(scene_.camera.width), uint32_t(scene_.camera.height), 1u);
+  // Over the pixels that may see the volume only: the outside variant of final shading ended
+  // the others' walks (their camera rays escape).
+  const uint32_t count = candidatesOut_ ? pixelOrder_.inside : uint32_t(pixelOrder_.pixels.size());
+  push.listBegin = 0;
+  push.listCount = count;
   const uint32_t last = std::min(tailDispatches_, first + kTailDispatchesPerSubmit);
   const uint32_t scope = timer_.begin(cmd, "restir tail");
   for (uint32_t i = first; i < last; ++i) {
     gpu::computeBarrier(cmd);
     push.countAlive = i + 1 == last ? 1u : 0u;
-    tail_->record(cmd, items, &push);
+    if (count > 0) tail_->record(cmd, glm::uvec3(count, 1, 1), &push);
   }
   timer_.end(cmd, scope);
   return last;

@@ -18,6 +18,7 @@
 #include "render/gpu_surfaces.h"
 #include "render/gpu_volume.h"
 #include "render/path_tracer.h"
+#include "render/pixel_order.h"
 #include "scene/scene.h"
 #include "shaders/shared/reservoir.h"
 #include "shaders/shared/restir_types.h"
@@ -53,6 +54,10 @@ struct RestirOptions {
   // the current one, instead of the one compiled for that case (PLUME_RS_SAME_DOMAIN: identity
   // shift, stored targets); the two must give one image to rounding (tests/test_restir.cpp).
   bool sameDomainTemporal = true;
+  // Tests only: false runs every pixel through the walking pipelines, instead of those whose
+  // camera rays may meet the volume only (render/pixel_order.h) and walk-free variants of the
+  // passes over the others (PLUME_RS_OUTSIDE); the two must give one image, bit for bit.
+  bool cullOutside = true;
   std::string name() const;  // e.g. "restir pairwise M4 k3 r16 R1 c20" (r: radius in px)
 };
 // From the scene's render settings (render.restir_mis; mode restir-biased's RS_MIS_BIASED is set
@@ -109,6 +114,9 @@ class Restir {
   std::unique_ptr<GpuEnvironmentMap> envMap_;
   std::unique_ptr<GpuSurfaces> surfaces_;  // only for a scene with surfaces
   std::unique_ptr<gpu::ComputePass> candidates_, temporal_, temporalSame_, spatial_, shade_;
+  // The passes' variants for the pixels whose camera rays miss the volume (PLUME_RS_OUTSIDE;
+  // null with surfaces, or without options_.cullOutside).
+  std::unique_ptr<gpu::ComputePass> candidatesOut_, temporalOut_, spatialOut_, shadeOut_;
   std::unique_ptr<gpu::ComputePass> tail_;  // final shading's tail (null without one)
   uint32_t tailDispatches_ = 0;             // its dispatches per frame at most (max_bounces' walk)
   gpu::GpuTimer timer_;
@@ -123,6 +131,12 @@ class Restir {
   uint64_t renderedSerial_ = 0;                      // the volume the history was rendered with
   shared::GpuCamera prevCam_{};
   glm::vec3 centre_{0.0f};  // world centre of the volume's bounds (reprojection depth)
+  shared::GpuVolume volume_{};  // the current volume's parameters (its box, for pixelOrder_)
+  // The frame's pixels, those that may see the volume first (render/pixel_order.h), and the
+  // camera and volume they were found for (recomputed and uploaded when either changes).
+  PixelOrder pixelOrder_;
+  shared::GpuCamera orderCam_{};
+  uint64_t orderSerial_ = 0;
   PassTimes passTimes_;
 };
 

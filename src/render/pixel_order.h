@@ -1,0 +1,43 @@
+// Which pixels' camera rays may meet a volume (render/restir.cpp orders its passes' pixels by it).
+// On a SIMD back end such as lavapipe a pixel whose rays miss the volume still costs its subgroup
+// masked passes of every walk its kernels hold (docs/architecture.md "Call sites, not calls, cost
+// time"): ReSTIR runs its walking kernels over the pixels that may meet the volume and walk-free
+// variants over the others (notes/restir.md "Session 24").
+#pragma once
+
+#include "shaders/shared/gpu_types.h"
+
+#include <glm/glm.hpp>
+
+#include <cstdint>
+#include <vector>
+
+namespace plume {
+
+// A frame's pixels, packed x | y << 16: first the `inside` ones, whose camera rays may meet the
+// volume's box at some sub-pixel position, then the others, whose every ray misses it; each part
+// in tile order (kPixelOrderTile² tiles row-major, each tile row-major), so that a workgroup of
+// 64 list entries covers an 8 x 8 tile where the tile is whole (its rays share cache lines: a
+// 64 x 1 strip made the Blender smoke's final shading ~20% slower) and its subgroups of 8 a row.
+constexpr int kPixelOrderTile = 8;
+struct PixelOrder {
+  std::vector<uint32_t> pixels;
+  uint32_t inside = 0;
+};
+
+// The index-space box [lo, hi] (GpuVolume boundsMin/Max: where the density may be non-zero) of a
+// volume with transform indexToWorld, seen by the pinhole camera `cam` (shared::cam_direction) on a
+// width x height image. Conservative: the box is grown by kPixelOrderBoxMargin index units and its
+// projection by kPixelOrderPixelMargin pixels, far above any rounding of the rays on a device; a
+// box that reaches the camera's plane makes every pixel inside; an empty volume none.
+constexpr float kPixelOrderBoxMargin = 0.05f;
+constexpr double kPixelOrderPixelMargin = 1.0;
+PixelOrder volumePixelOrder(const shared::GpuCamera& cam, int width, int height, glm::vec3 lo, glm::vec3 hi,
+                            const glm::mat4& indexToWorld, bool empty);
+
+// Every pixel, in tile order, all inside.
+PixelOrder allPixels(int width, int height);
+
+inline uint32_t packPixel(uint32_t x, uint32_t y) { return x | y << 16; }
+
+}  // namespace plume

@@ -1,0 +1,172 @@
+// render/pixel_order.h: the pixels whose camera rays may meet a volume's box (ReSTIR runs walk-free
+// variants of its passes over the others, so a pixel left out wrongly would lose its light). CPU
+// only: random cameras and boxes (rotated, scaled, moved), random sub-pixel rays intersected with
+// the box in double precision; every pixel with a hit must be in the list's inside part, and
+// every inside pixel must be near a hit (the margins are a pixel and a twentieth of a voxel),
+// unless the box reaches the camera's plane (then every pixel is inside).
+#include "render/gpu_scene.h"
+#include "render/pixel_order.h"
+#include "scene/scene.h"
+
+#include <glm/glm.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <set>
+#include <tuple>
+
+using namespace plume;
+
+namespace {
+
+shared::GpuCamera cameraAt(glm::vec3 position, glm::vec3 lookAt, float fovY, int width, int height) {
+  Camera c;
+  c.base.position = position;
+  c.base.lookAt = lookAt;
+  c.base.fovY = fovY;
+  c.width = width;
+  c.height = height;
+  return gpuCamera(c, 0);
+}
+
+// The ray through image point (px, py) meets the index-space box [lo, hi] (slab test, double).
+bool rayMeetsBox(const shared::GpuCamera& cam, int width, int height, double px, double py, glm::dvec3 lo,
+                 glm::dvec3 hi, const glm::dmat4& worldToIndex) {
+  const double sx = (2.0 * px / width - 1.0) * cam.tanHalfFovY * cam.aspect;
+  const double sy = (1.0 - 2.0 * py / height) * cam.tanHalfFovY;
+  const glm::dvec3 dir = glm::dvec3(cam.forward) + sx * glm::dvec3(cam.right) + sy * glm::dvec3(cam.up);
+  const glm::dvec3 o = glm::dvec3(worldToIndex * glm::dvec4(glm::dvec3(cam.position), 1.0));
+  const glm::dvec3 d = glm::dvec3(worldToIndex * glm::dvec4(dir, 0.0));
+  double t0 = 0.0, t1 = 1e300;
+  for (int a = 0; a < 3; ++a) {
+    if (d[a] == 0.0) {
+      if (o[a] < lo[a] || o[a] > hi[a]) return false;
+      continue;
+    }
+    double ta = (lo[a] - o[a]) / d[a], tb = (hi[a] - o[a]) / d[a];
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+  }
+  return t0 < t1;
+}
+
+struct Split {
+  size_t inside = 0, hits = 0, missed = 0, far = 0;
+};
+
+Split check(const shared::GpuCamera& cam, int width, int height, glm::vec3 lo, glm::vec3 hi, const glm::mat4& indexToWorld,
+            std::mt19937& rng) {
+  const PixelOrder order = volumePixelOrder(cam, width, height, lo, hi, indexToWorld, false);
+  EXPECT_EQ(order.pixels.size(), size_t(width) * height);
+  std::vector<char> in(size_t(width) * height, 0);
+  for (uint32_t i = 0; i < order.pixels.size(); ++i) {
+    const uint32_t x = order.pixels[i] & 0xffffu, y = order.pixels[i] >> 16;
+    EXPECT_EQ(in[y * width + x], 0) << "pixel listed twice";
+    in[y * width + x] = i < order.inside ? 1 : 2;
+  }
+  const glm::dmat4 worldToIndex = glm::inverse(glm::dmat4(indexToWorld));
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<char> hit(in.size(), 0);
+  Split s;
+  s.inside = order.inside;
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      bool any = false;
+      for (int k = 0; k < 24 && !any; ++k) {
+        const double fx = k < 4 ? (k & 1) : k == 4 ? 0.5 : u(rng), fy = k < 4 ? (k >> 1) : k == 4 ? 0.5 : u(rng);
+        any = rayMeetsBox(cam, width, height, x + fx, y + fy, lo, hi, worldToIndex);
+      }
+      hit[size_t(y) * width + x] = any ? 1 : 0;
+      s.hits += any ? 1 : 0;
+      if (any && in[size_t(y) * width + x] != 1) ++s.missed;
+    }
+  }
+  // Inside pixels farther than 3 pixels from any pixel with a hit: the margins are ~1-2 pixels.
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      if (in[size_t(y) * width + x] != 1) continue;
+      bool near = false;
+      for (int dy = -3; dy <= 3 && !near; ++dy)
+        for (int dx = -3; dx <= 3 && !near; ++dx) {
+          const int qx = x + dx, qy = y + dy;
+          near = qx >= 0 && qy >= 0 && qx < width && qy < height && hit[size_t(qy) * width + qx];
+        }
+      s.far += near ? 0 : 1;
+    }
+  }
+  return s;
+}
+
+TEST(PixelOrder, EveryPixelThatSeesTheBoxIsInsideAndFewOthersAre) {
+  std::mt19937 rng(12345);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  size_t missed = 0, far = 0, inside = 0, hits = 0, cases = 0, partial = 0, whole = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    const int width = 24 + int(rng() % 40), height = 16 + int(rng() % 40);
+    // A box of 20-60 voxels per axis, rotated, scaled to 1/20-1/10 world units per voxel, moved.
+    const glm::vec3 lo(float(rng() % 10), float(rng() % 10), float(rng() % 10));
+    const glm::vec3 hi = lo + glm::vec3(20 + rng() % 40, 20 + rng() % 40, 20 + rng() % 40);
+    glm::mat4 m = glm::translate(glm::mat4(1.0f), glm::vec3(u(rng), u(rng), u(rng)));
+    m = glm::rotate(m, 3.0f * u(rng), glm::normalize(glm::vec3(u(rng), u(rng), u(rng)) + glm::vec3(0.0f, 0.0f, 1e-3f)));
+    m = glm::scale(m, glm::vec3(0.05f + 0.05f * std::abs(u(rng))));
+    const glm::vec3 centre = glm::vec3(m * glm::vec4(0.5f * (lo + hi), 1.0f));
+    // Cameras from 3 to 12 units away, looking near the box (sometimes past it).
+    const glm::vec3 dir = glm::normalize(glm::vec3(u(rng), u(rng), u(rng)) + glm::vec3(0.0f, 0.0f, 1e-3f));
+    const glm::vec3 position = centre + (3.0f + 4.5f * (u(rng) + 1.0f)) * dir;
+    const glm::vec3 lookAt = centre + 1.5f * glm::vec3(u(rng), u(rng), u(rng));
+    const shared::GpuCamera cam = cameraAt(position, lookAt, 25.0f + 20.0f * (u(rng) + 1.0f), width, height);
+    const Split s = check(cam, width, height, lo, hi, m, rng);
+    missed += s.missed;
+    // (Where the box reaches the camera's plane every pixel is inside, by design: not counted.)
+    const bool everything = s.inside == size_t(width) * height;
+    far += everything ? 0 : s.far;
+    whole += everything ? 1 : 0;
+    inside += s.inside;
+    hits += s.hits;
+    partial += s.inside > 0 && s.inside < size_t(width) * height ? 1 : 0;
+    ++cases;
+  }
+  std::printf("[pixel order] %zu cameras (%zu see part of the box, %zu have every pixel inside): %zu pixels with a "
+              "hit, %zu inside, %zu hit pixels left out, %zu inside pixels farther than 3 px from a hit\n",
+              cases, partial, whole, hits, inside, missed, far);
+  EXPECT_EQ(missed, 0u) << "a pixel that sees the box must be inside";
+  EXPECT_EQ(far, 0u) << "inside pixels must be near the box's projection";
+  EXPECT_GT(partial, cases / 2) << "the cameras must mostly see part of the box";
+  EXPECT_LT(whole, cases / 10) << "few boxes may reach the camera's plane";
+}
+
+TEST(PixelOrder, BoxesBehindAroundOrEmpty) {
+  const glm::vec3 lo(0.0f), hi(40.0f);
+  const glm::mat4 m = glm::scale(glm::mat4(1.0f), glm::vec3(0.05f));  // the box [0, 2]^3 in world units
+  // Behind the camera: no pixel. Around it: every pixel. Empty volume: none.
+  const shared::GpuCamera away = cameraAt({1.0f, 1.0f, 5.0f}, {1.0f, 1.0f, 9.0f}, 40.0f, 32, 24);
+  EXPECT_EQ(volumePixelOrder(away, 32, 24, lo, hi, m, false).inside, 0u);
+  const shared::GpuCamera in = cameraAt({1.0f, 1.0f, 1.0f}, {1.0f, 1.0f, 9.0f}, 40.0f, 32, 24);
+  EXPECT_EQ(volumePixelOrder(in, 32, 24, lo, hi, m, false).inside, 32u * 24u);
+  const shared::GpuCamera front = cameraAt({1.0f, 1.0f, 8.0f}, {1.0f, 1.0f, 1.0f}, 40.0f, 32, 24);
+  const PixelOrder seen = volumePixelOrder(front, 32, 24, lo, hi, m, false);
+  EXPECT_GT(seen.inside, 0u);
+  EXPECT_LT(seen.inside, 32u * 24u);
+  EXPECT_EQ(volumePixelOrder(front, 32, 24, lo, hi, m, true).inside, 0u);
+  // The list holds every pixel once, inside ones first, each part in tile order (8 x 8 tiles
+  // row-major, each tile row-major).
+  std::set<uint32_t> all(seen.pixels.begin(), seen.pixels.end());
+  EXPECT_EQ(all.size(), 32u * 24u);
+  auto key = [](uint32_t p) {
+    const uint32_t x = p & 0xffffu, y = p >> 16;
+    return std::make_tuple(y / 8, x / 8, y, x);
+  };
+  auto tileOrder = [&](uint32_t a, uint32_t b) { return key(a) < key(b); };
+  EXPECT_TRUE(std::is_sorted(seen.pixels.begin(), seen.pixels.begin() + seen.inside, tileOrder));
+  EXPECT_TRUE(std::is_sorted(seen.pixels.begin() + seen.inside, seen.pixels.end(), tileOrder));
+  const PixelOrder every = allPixels(20, 12);  // partial tiles at the right and bottom edges
+  EXPECT_EQ(every.inside, 240u);
+  EXPECT_TRUE(std::is_sorted(every.pixels.begin(), every.pixels.end(), tileOrder));
+  EXPECT_EQ(std::set<uint32_t>(every.pixels.begin(), every.pixels.end()).size(), 240u);
+}
+
+}  // namespace
