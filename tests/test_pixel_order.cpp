@@ -1,4 +1,5 @@
-// render/pixel_order.h: the pixels whose camera rays may meet a volume's box (ReSTIR runs walk-free
+// render/pixel_order.h: the pixels whose camera rays may meet a volume's footprint (its box, or its
+// occupied cells) (ReSTIR runs walk-free
 // variants of its passes over the others, so a pixel left out wrongly would lose its light). CPU
 // only: random cameras and boxes (rotated, scaled, moved), random sub-pixel rays intersected with
 // the box in double precision; every pixel with a hit must be in the list's inside part, and
@@ -54,13 +55,25 @@ bool rayMeetsBox(const shared::GpuCamera& cam, int width, int height, double px,
   return t0 < t1;
 }
 
+VolumeFootprint footprintOf(glm::vec3 lo, glm::vec3 hi, const glm::mat4& indexToWorld, bool empty = false,
+                            std::vector<IndexBox> cells = {}) {
+  VolumeFootprint v;
+  v.bounds = {lo, hi};
+  v.indexToWorld = indexToWorld;
+  v.empty = empty;
+  v.cells = std::move(cells);
+  return v;
+}
+
 struct Split {
   size_t inside = 0, hits = 0, missed = 0, far = 0;
 };
 
-Split check(const shared::GpuCamera& cam, int width, int height, glm::vec3 lo, glm::vec3 hi, const glm::mat4& indexToWorld,
-            std::mt19937& rng) {
-  const PixelOrder order = volumePixelOrder(cam, width, height, lo, hi, indexToWorld, false);
+// The footprint's boxes: the occupied cells, or the bounds where there are none.
+Split check(const shared::GpuCamera& cam, int width, int height, const VolumeFootprint& v, std::mt19937& rng) {
+  const PixelOrder order = volumePixelOrder(cam, width, height, v);
+  std::vector<IndexBox> boxes = v.cells;
+  if (boxes.empty()) boxes.push_back(v.bounds);
   EXPECT_EQ(order.pixels.size(), size_t(width) * height);
   std::vector<char> in(size_t(width) * height, 0);
   for (uint32_t i = 0; i < order.pixels.size(); ++i) {
@@ -68,7 +81,7 @@ Split check(const shared::GpuCamera& cam, int width, int height, glm::vec3 lo, g
     EXPECT_EQ(in[y * width + x], 0) << "pixel listed twice";
     in[y * width + x] = i < order.inside ? 1 : 2;
   }
-  const glm::dmat4 worldToIndex = glm::inverse(glm::dmat4(indexToWorld));
+  const glm::dmat4 worldToIndex = glm::inverse(glm::dmat4(v.indexToWorld));
   std::uniform_real_distribution<double> u(0.0, 1.0);
   std::vector<char> hit(in.size(), 0);
   Split s;
@@ -78,7 +91,9 @@ Split check(const shared::GpuCamera& cam, int width, int height, glm::vec3 lo, g
       bool any = false;
       for (int k = 0; k < 24 && !any; ++k) {
         const double fx = k < 4 ? (k & 1) : k == 4 ? 0.5 : u(rng), fy = k < 4 ? (k >> 1) : k == 4 ? 0.5 : u(rng);
-        any = rayMeetsBox(cam, width, height, x + fx, y + fy, lo, hi, worldToIndex);
+        for (const IndexBox& b : boxes) {
+          any = any || rayMeetsBox(cam, width, height, x + fx, y + fy, glm::dvec3(b.lo), glm::dvec3(b.hi), worldToIndex);
+        }
       }
       hit[size_t(y) * width + x] = any ? 1 : 0;
       s.hits += any ? 1 : 0;
@@ -104,7 +119,7 @@ Split check(const shared::GpuCamera& cam, int width, int height, glm::vec3 lo, g
 TEST(PixelOrder, EveryPixelThatSeesTheBoxIsInsideAndFewOthersAre) {
   std::mt19937 rng(12345);
   std::uniform_real_distribution<float> u(-1.0f, 1.0f);
-  size_t missed = 0, far = 0, inside = 0, hits = 0, cases = 0, partial = 0, whole = 0;
+  size_t missed = 0, far = 0, inside = 0, hits = 0, cases = 0, partial = 0, whole = 0, widened = 0, fewer = 0;
   for (int trial = 0; trial < 60; ++trial) {
     const int width = 24 + int(rng() % 40), height = 16 + int(rng() % 40);
     // A box of 20-60 voxels per axis, rotated, scaled to 1/20-1/10 world units per voxel, moved.
@@ -119,11 +134,30 @@ TEST(PixelOrder, EveryPixelThatSeesTheBoxIsInsideAndFewOthersAre) {
     const glm::vec3 position = centre + (3.0f + 4.5f * (u(rng) + 1.0f)) * dir;
     const glm::vec3 lookAt = centre + 1.5f * glm::vec3(u(rng), u(rng), u(rng));
     const shared::GpuCamera cam = cameraAt(position, lookAt, 25.0f + 20.0f * (u(rng) + 1.0f), width, height);
-    const Split s = check(cam, width, height, lo, hi, m, rng);
+    // Every other trial with occupied cells: a 4 x 4 x 4 grid over the box, each cell kept with
+    // probability 0.3 (at least one).
+    std::vector<IndexBox> cells;
+    if (trial % 2 == 1) {
+      const glm::vec3 side = (hi - lo) / 4.0f;
+      for (int c = 0; c < 64; ++c) {
+        if (rng() % 10 >= 3 && !(c == 63 && cells.empty())) continue;
+        const glm::vec3 at = lo + side * glm::vec3(c % 4, (c / 4) % 4, c / 16);
+        cells.push_back({at, at + side});
+      }
+    }
+    const Split s = check(cam, width, height, footprintOf(lo, hi, m, false, cells), rng);
     missed += s.missed;
-    // (Where the box reaches the camera's plane every pixel is inside, by design: not counted.)
+    // (Where the box reaches the camera's plane every pixel is inside, by design: not counted; a
+    // cell's projection is its bounding rectangle, looser than a hull: the cells may only take
+    // pixels away from the box's.)
     const bool everything = s.inside == size_t(width) * height;
-    far += everything ? 0 : s.far;
+    if (cells.empty()) {
+      far += everything ? 0 : s.far;
+    } else {
+      const size_t box = volumePixelOrder(cam, width, height, footprintOf(lo, hi, m)).inside;
+      widened += s.inside > box ? 1 : 0;
+      fewer += s.inside < box ? 1 : 0;
+    }
     whole += everything ? 1 : 0;
     inside += s.inside;
     hits += s.hits;
@@ -131,12 +165,15 @@ TEST(PixelOrder, EveryPixelThatSeesTheBoxIsInsideAndFewOthersAre) {
     ++cases;
   }
   std::printf("[pixel order] %zu cameras (%zu see part of the box, %zu have every pixel inside): %zu pixels with a "
-              "hit, %zu inside, %zu hit pixels left out, %zu inside pixels farther than 3 px from a hit\n",
-              cases, partial, whole, hits, inside, missed, far);
+              "hit, %zu inside, %zu hit pixels left out, %zu inside pixels farther than 3 px from a hit (box only); "
+              "cells took pixels away in %zu cases\n",
+              cases, partial, whole, hits, inside, missed, far, fewer);
   EXPECT_EQ(missed, 0u) << "a pixel that sees the box must be inside";
   EXPECT_EQ(far, 0u) << "inside pixels must be near the box's projection";
   EXPECT_GT(partial, cases / 2) << "the cameras must mostly see part of the box";
   EXPECT_LT(whole, cases / 10) << "few boxes may reach the camera's plane";
+  EXPECT_EQ(widened, 0u) << "occupied cells must never add pixels to the box's";
+  EXPECT_GT(fewer, cases / 4) << "occupied cells must usually take pixels away";
 }
 
 TEST(PixelOrder, BoxesBehindAroundOrEmpty) {
@@ -144,14 +181,18 @@ TEST(PixelOrder, BoxesBehindAroundOrEmpty) {
   const glm::mat4 m = glm::scale(glm::mat4(1.0f), glm::vec3(0.05f));  // the box [0, 2]^3 in world units
   // Behind the camera: no pixel. Around it: every pixel. Empty volume: none.
   const shared::GpuCamera away = cameraAt({1.0f, 1.0f, 5.0f}, {1.0f, 1.0f, 9.0f}, 40.0f, 32, 24);
-  EXPECT_EQ(volumePixelOrder(away, 32, 24, lo, hi, m, false).inside, 0u);
+  EXPECT_EQ(volumePixelOrder(away, 32, 24, footprintOf(lo, hi, m)).inside, 0u);
   const shared::GpuCamera in = cameraAt({1.0f, 1.0f, 1.0f}, {1.0f, 1.0f, 9.0f}, 40.0f, 32, 24);
-  EXPECT_EQ(volumePixelOrder(in, 32, 24, lo, hi, m, false).inside, 32u * 24u);
+  EXPECT_EQ(volumePixelOrder(in, 32, 24, footprintOf(lo, hi, m)).inside, 32u * 24u);
   const shared::GpuCamera front = cameraAt({1.0f, 1.0f, 8.0f}, {1.0f, 1.0f, 1.0f}, 40.0f, 32, 24);
-  const PixelOrder seen = volumePixelOrder(front, 32, 24, lo, hi, m, false);
+  const PixelOrder seen = volumePixelOrder(front, 32, 24, footprintOf(lo, hi, m));
   EXPECT_GT(seen.inside, 0u);
   EXPECT_LT(seen.inside, 32u * 24u);
-  EXPECT_EQ(volumePixelOrder(front, 32, 24, lo, hi, m, true).inside, 0u);
+  EXPECT_EQ(volumePixelOrder(front, 32, 24, footprintOf(lo, hi, m, true)).inside, 0u);
+  // One occupied cell, the box's far corner: fewer pixels than the whole box.
+  const PixelOrder cell = volumePixelOrder(front, 32, 24, footprintOf(lo, hi, m, false, {{glm::vec3(30.0f), hi}}));
+  EXPECT_GT(cell.inside, 0u);
+  EXPECT_LT(cell.inside, seen.inside / 4);
   // The list holds every pixel once, inside ones first, each part in tile order (8 x 8 tiles
   // row-major, each tile row-major).
   std::set<uint32_t> all(seen.pixels.begin(), seen.pixels.end());

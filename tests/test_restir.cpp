@@ -370,6 +370,20 @@ TEST_F(GpuRestir, PixelsThatMissTheVolumeSkipTheWalksAndKeepTheImage) {
   key.pose.position = {2.4f, 1.6f, 7.0f};
   moving.camera.keys.push_back(key);
   auto gridAt = [](int frame) { return test::makeNoiseGrid(40, 1.0 / 20, unsigned(10 + frame)); };
+  // Two blobs 60 voxels apart, side by side in view: the box's middle is empty bricks, which the
+  // footprint's occupied cells leave out.
+  auto sparseGrid = [](int) {
+    auto grid = test::makeNoiseGrid(20, 1.0 / 20, 9);
+    auto other = test::makeNoiseGrid(20, 1.0 / 20, 11);
+    auto acc = grid->getAccessor();
+    for (auto it = other->cbeginValueOn(); it; ++it) acc.setValue(it.getCoord() + openvdb::Coord(60, 4, 0), *it);
+    return grid;
+  };
+  Scene sparse = moving;
+  sparse.camera.base.position = {2.0f, 0.7f, 6.5f};
+  sparse.camera.base.lookAt = {2.0f, 0.6f, 0.5f};
+  sparse.camera.keys[0].pose = sparse.camera.base;
+  sparse.camera.keys[0].pose.position = {2.6f, 1.0f, 6.3f};
   struct Case {
     const char* name;
     const Scene* scene;
@@ -377,17 +391,21 @@ TEST_F(GpuRestir, PixelsThatMissTheVolumeSkipTheWalksAndKeepTheImage) {
     int maxBounces;
     int prefix;
     uint32_t mis;
+    bool sparse;
   };
-  const Case cases[] = {{"still camera", &still, false, 1, 16, shared::RS_MIS_PAIRWISE},
-                        {"moving camera", &moving, false, 1, 16, shared::RS_MIS_PAIRWISE},
-                        {"moving camera, animated grid, tail", &moving, true, 3, 1, shared::RS_MIS_PAIRWISE},
-                        {"moving camera, gbh", &moving, false, 2, 16, shared::RS_MIS_GBH}};
+  const Case cases[] = {{"still camera", &still, false, 1, 16, shared::RS_MIS_PAIRWISE, false},
+                        {"moving camera", &moving, false, 1, 16, shared::RS_MIS_PAIRWISE, false},
+                        {"moving camera, animated grid, tail", &moving, true, 3, 1, shared::RS_MIS_PAIRWISE, false},
+                        {"moving camera, gbh", &moving, false, 2, 16, shared::RS_MIS_GBH, false},
+                        {"moving camera, two blobs (empty bricks between)", &sparse, false, 2, 16,
+                         shared::RS_MIS_PAIRWISE, true}};
   for (const Case& c : cases) {
     Scene s = *c.scene;
     s.render.maxBounces = c.maxBounces;
     std::vector<std::unique_ptr<GpuVolumeResources>> volumes;  // one per frame, or one for all
     for (int f = 1; f <= (c.animated ? 4 : 1); ++f) {
-      volumes.push_back(std::make_unique<GpuVolumeResources>(ctx(), *bakeOf(gridAt(f)), s.media[0].densityScale));
+      volumes.push_back(std::make_unique<GpuVolumeResources>(ctx(), *bakeOf(c.sparse ? sparseGrid(f) : gridAt(f)),
+                                                             s.media[0].densityScale));
     }
     auto frames = [&](bool cull) {
       RestirOptions o;
@@ -413,11 +431,14 @@ TEST_F(GpuRestir, PixelsThatMissTheVolumeSkipTheWalksAndKeepTheImage) {
       }
     }
     // The split the last frame used: the frame's camera over its volume's box.
-    const shared::GpuVolume& v = volumes.back()->params();
-    const PixelOrder order = volumePixelOrder(gpuCamera(s.camera, 4), s.camera.width, s.camera.height,
-                                              v.boundsMin, v.boundsMax, v.indexToWorld, v.empty != 0);
-    std::printf("[restir] outside variants, %s: %u of %zu pixels may see the volume; %zu of %zu channels differ\n",
-                c.name, order.inside, order.pixels.size(), differ, lit);
+    const VolumeFootprint& footprint = volumes.back()->footprint();
+    const PixelOrder order = volumePixelOrder(gpuCamera(s.camera, 4), s.camera.width, s.camera.height, footprint);
+    VolumeFootprint box = footprint;
+    box.cells.clear();
+    const uint32_t boxInside = volumePixelOrder(gpuCamera(s.camera, 4), s.camera.width, s.camera.height, box).inside;
+    std::printf("[restir] outside variants, %s: %u of %zu pixels may see the volume (%u by its box alone); %zu of "
+                "%zu channels differ\n", c.name, order.inside, order.pixels.size(), boxInside, differ, lit);
+    if (c.sparse) EXPECT_LT(order.inside, boxInside * 9 / 10) << c.name << ": the empty bricks must take pixels away";
     EXPECT_EQ(differ, 0u) << c.name << ": the outside variants must not change any pixel";
     EXPECT_GT(order.inside, order.pixels.size() / 10) << c.name;
     EXPECT_LT(order.inside, order.pixels.size() * 9 / 10) << c.name;

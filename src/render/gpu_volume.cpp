@@ -44,6 +44,27 @@ GpuVolumeResources::GpuVolumeResources(gpu::Context& ctx, const BakedVolume& bak
     throw InternalError("bake: level 0 of the majorant hierarchy must match the indirection grid");
   }
   params_.levelCount = uint32_t(levels);
+  // The footprint: a lookup inside a cell of level k reads at most the cell's majorant (its max
+  // over the texels its lookups read), so the density is 0 outside the cells whose majorant is
+  // not. Cell c of level k covers the bricks brickOrigin + c * cellBricks + [0, cellBricks)³,
+  // index-space points [8 b, 8 b + 8) of brick b (shaders/volume/grid.glsl vol_locate).
+  footprint_.bounds = {bake.indexBoundsMin, bake.indexBoundsMax};
+  footprint_.indexToWorld = params_.indexToWorld;
+  footprint_.empty = empty;
+  for (const MaxLevel& L : bake.maxLevels) {
+    const size_t occupied = size_t(std::count_if(L.max.begin(), L.max.end(), [](float m) { return m > 0.0f; }));
+    if (occupied > kFootprintCells) continue;
+    const float side = float(kBrickVoxels * L.cellBricks);
+    const glm::vec3 origin = glm::vec3(bake.brickOrigin * kBrickVoxels);
+    for (int z = 0; z < L.dims.z; ++z)
+      for (int y = 0; y < L.dims.y; ++y)
+        for (int x = 0; x < L.dims.x; ++x) {
+          if (!(L.max[(size_t(z) * L.dims.y + y) * L.dims.x + x] > 0.0f)) continue;
+          const glm::vec3 lo = origin + side * glm::vec3(x, y, z);
+          footprint_.cells.push_back({lo, lo + side});
+        }
+    break;
+  }
 
   const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   paramBuffer_ = gpu::Buffer(ctx, sizeof(params_), storage, "volume parameters");

@@ -7,6 +7,7 @@
 #include "gpu/pipeline.h"
 #include "gpu/resources.h"
 #include "media/bake.h"
+#include "render/pixel_order.h"
 #include "scene/scene.h"
 #include "shaders/shared/bindings.h"
 #include "shaders/shared/gpu_types.h"
@@ -40,6 +41,10 @@ class GpuVolumeResources {
   // Binds this volume as ReSTIR's previous-frame volume (BIND_PREV_*).
   void bindAsPrevious(gpu::DescriptorSet& set) const;
   const shared::GpuVolume& params() const { return params_; }
+  // Where the density may be non-zero (render/pixel_order.h): the bounds and the non-zero cells of
+  // the finest level of the majorant hierarchy that has at most kFootprintCells of them.
+  const VolumeFootprint& footprint() const { return footprint_; }
+  static constexpr size_t kFootprintCells = 4096;
   // For render.density_filter = biased-hardware (shaders read the atlases with texture()): throws
   // InputError, naming the setting, where the device cannot filter the atlases' formats linearly.
   void requireLinearFilter() const;
@@ -64,6 +69,7 @@ class GpuVolumeResources {
 
  private:
   shared::GpuVolume params_{};
+  VolumeFootprint footprint_;
   bool hasMeanField_ = false;
   gpu::Buffer paramBuffer_;
   gpu::Image3D atlas_;

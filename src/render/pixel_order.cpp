@@ -33,26 +33,25 @@ PixelOrder allPixels(int width, int height) {
   return order;
 }
 
-PixelOrder volumePixelOrder(const shared::GpuCamera& cam, int width, int height, glm::vec3 lo, glm::vec3 hi,
-                            const glm::mat4& indexToWorld, bool empty) {
-  PLUME_CHECK(width > 0 && height > 0 && width <= 65536 && height <= 65536);
-  const size_t n = size_t(width) * size_t(height);
-  auto all = [&](bool inside) {
-    PixelOrder order = allPixels(width, height);
-    if (!inside) order.inside = 0;
-    return order;
-  };
-  if (empty) return all(false);
-  // The box's corners on the image, in pixels (x right, y down: cam_direction's inverse). The
-  // projection of the box is the convex hull of its corners' projections.
+namespace {
+
+// A projected box: its corners on the image, in pixels (x right, y down: cam_direction's
+// inverse), and where it lies: 0 in front of the camera's plane, 1 wholly behind it, 2 across it.
+struct Projected {
+  std::array<glm::dvec2, 8> p;
+  int side = 0;
+};
+
+Projected project(const shared::GpuCamera& cam, int width, int height, const IndexBox& box, const glm::mat4& indexToWorld) {
   const glm::dvec3 pos(cam.position), fwd(cam.forward), right(cam.right), up(cam.up);
   const double tanY = double(cam.tanHalfFovY), tanX = tanY * double(cam.aspect);
-  std::array<glm::dvec2, 8> p;
+  Projected out;
   int behind = 0;
+  bool finite = true;
   for (int c = 0; c < 8; ++c) {
-    const glm::vec3 corner((c & 1) ? hi.x + kPixelOrderBoxMargin : lo.x - kPixelOrderBoxMargin,
-                           (c & 2) ? hi.y + kPixelOrderBoxMargin : lo.y - kPixelOrderBoxMargin,
-                           (c & 4) ? hi.z + kPixelOrderBoxMargin : lo.z - kPixelOrderBoxMargin);
+    const glm::vec3 corner((c & 1) ? box.hi.x + kPixelOrderBoxMargin : box.lo.x - kPixelOrderBoxMargin,
+                           (c & 2) ? box.hi.y + kPixelOrderBoxMargin : box.lo.y - kPixelOrderBoxMargin,
+                           (c & 4) ? box.hi.z + kPixelOrderBoxMargin : box.lo.z - kPixelOrderBoxMargin);
     const glm::dvec3 d = glm::dvec3(glm::vec3(indexToWorld * glm::vec4(corner, 1.0f))) - pos;
     const double z = glm::dot(d, fwd);
     if (!(z > 1e-9 * std::max(1.0, glm::length(d)))) {
@@ -60,17 +59,42 @@ PixelOrder volumePixelOrder(const shared::GpuCamera& cam, int width, int height,
       continue;
     }
     const double sx = glm::dot(d, right) / z / tanX, sy = glm::dot(d, up) / z / tanY;
-    p[c] = glm::dvec2((sx + 1.0) * 0.5 * width, (1.0 - sy) * 0.5 * height);
-    if (!std::isfinite(p[c].x) || !std::isfinite(p[c].y)) return all(true);
+    out.p[size_t(c)] = glm::dvec2((sx + 1.0) * 0.5 * width, (1.0 - sy) * 0.5 * height);
+    finite = finite && std::isfinite(out.p[size_t(c)].x) && std::isfinite(out.p[size_t(c)].y);
   }
   // Every ray leaves the camera forwards (cam_direction: forward plus a sideways part), so a box
   // wholly behind its plane is seen by no pixel; one that reaches the plane from in front (or
-  // holds the camera) projects without bound: every pixel may see it.
-  if (behind == 8) return all(false);
-  if (behind > 0) return all(true);
-  // Per row of pixels: the x-extent of the hull within the row's slab (grown by the margin) is
-  // the extent of the corners inside the slab and of every segment between two corners where it
-  // crosses the slab's edges (points of the hull, and they include the hull's own vertices there).
+  // holds the camera) projects without bound.
+  out.side = behind == 8 ? 1 : behind != 0 || !finite ? 2 : 0;
+  return out;
+}
+
+// The pixel columns [x0, x1) of a row whose squares may meet [xmin, xmax] grown by the margin.
+void columns(double xmin, double xmax, int width, int& x0, int& x1) {
+  const double m = kPixelOrderPixelMargin;
+  x0 = int(std::clamp(std::floor(xmin - m), 0.0, double(width)));
+  x1 = int(std::clamp(std::ceil(xmax + m) + 1.0, 0.0, double(width)));
+}
+
+}  // namespace
+
+PixelOrder volumePixelOrder(const shared::GpuCamera& cam, int width, int height, const VolumeFootprint& volume) {
+  PLUME_CHECK(width > 0 && height > 0 && width <= 65536 && height <= 65536);
+  const size_t n = size_t(width) * size_t(height);
+  auto all = [&](bool inside) {
+    PixelOrder order = allPixels(width, height);
+    if (!inside) order.inside = 0;
+    return order;
+  };
+  if (volume.empty) return all(false);
+  const Projected bounds = project(cam, width, height, volume.bounds, volume.indexToWorld);
+  if (bounds.side == 1) return all(false);
+  if (bounds.side == 2) return all(true);
+  const std::array<glm::dvec2, 8>& p = bounds.p;
+  // Per row of pixels: the x-extent of the bounds' hull within the row's slab (grown by the
+  // margin) is the extent of the corners inside the slab and of every segment between two corners
+  // where it crosses the slab's edges (points of the hull, and they include the hull's own
+  // vertices there).
   std::vector<char> in(n, 0);
   const double m = kPixelOrderPixelMargin;
   for (int y = 0; y < height; ++y) {
@@ -90,9 +114,34 @@ PixelOrder volumePixelOrder(const shared::GpuCamera& cam, int width, int height,
       }
     }
     if (!(xmin <= xmax)) continue;
-    const int x0 = int(std::clamp(std::floor(xmin - m), 0.0, double(width)));
-    const int x1 = int(std::clamp(std::ceil(xmax + m) + 1.0, 0.0, double(width)));
+    int x0, x1;
+    columns(xmin, xmax, width, x0, x1);
     for (int x = x0; x < x1; ++x) in[size_t(y) * width + x] = 1;
+  }
+  // Within the bounds' pixels, those of the occupied cells' bounding rectangles only.
+  if (!volume.cells.empty()) {
+    std::vector<char> cell(n, 0);
+    for (const IndexBox& box : volume.cells) {
+      const Projected c = project(cam, width, height, box, volume.indexToWorld);
+      if (c.side == 1) continue;
+      if (c.side == 2) {
+        std::fill(cell.begin(), cell.end(), char(1));
+        break;
+      }
+      double xmin = c.p[0].x, xmax = xmin, ymin = c.p[0].y, ymax = ymin;
+      for (const glm::dvec2& q : c.p) {
+        xmin = std::min(xmin, q.x);
+        xmax = std::max(xmax, q.x);
+        ymin = std::min(ymin, q.y);
+        ymax = std::max(ymax, q.y);
+      }
+      int x0, x1, yb0, yb1;
+      columns(xmin, xmax, width, x0, x1);
+      columns(ymin, ymax, height, yb0, yb1);
+      for (int y = yb0; y < yb1; ++y)
+        for (int x = x0; x < x1; ++x) cell[size_t(y) * width + x] = 1;
+    }
+    for (size_t i = 0; i < n; ++i) in[i] = char(in[i] && cell[i]);
   }
   PixelOrder order;
   order.pixels.reserve(n);

@@ -25,15 +25,30 @@ struct PixelOrder {
   uint32_t inside = 0;
 };
 
-// The index-space box [lo, hi] (GpuVolume boundsMin/Max: where the density may be non-zero) of a
-// volume with transform indexToWorld, seen by the pinhole camera `cam` (shared::cam_direction) on a
-// width x height image. Conservative: the box is grown by kPixelOrderBoxMargin index units and its
-// projection by kPixelOrderPixelMargin pixels, far above any rounding of the rays on a device; a
-// box that reaches the camera's plane makes every pixel inside; an empty volume none.
+// An index-space box.
+struct IndexBox {
+  glm::vec3 lo{0.0f}, hi{0.0f};
+};
+
+// Where a volume's density may be non-zero, in index space: inside `bounds` (GpuVolume
+// boundsMin/Max) and, where `cells` is not empty, inside one of them (the cells of one level of
+// the majorant hierarchy whose majorant is not 0: render/gpu_volume.cpp).
+struct VolumeFootprint {
+  IndexBox bounds;
+  std::vector<IndexBox> cells;
+  glm::mat4 indexToWorld{1.0f};
+  bool empty = false;
+};
+
+// The pixels of a width x height image seen by the pinhole camera `cam` (shared::cam_direction)
+// whose rays may meet the footprint. Conservative: every box is grown by kPixelOrderBoxMargin
+// index units and its projection by kPixelOrderPixelMargin pixels, far above any rounding of the
+// rays on a device; the bounds' projection is their hull, a cell's its bounding rectangle; a box
+// that reaches the camera's plane makes every pixel inside (one wholly behind it none); an empty
+// volume has none inside.
 constexpr float kPixelOrderBoxMargin = 0.05f;
 constexpr double kPixelOrderPixelMargin = 1.0;
-PixelOrder volumePixelOrder(const shared::GpuCamera& cam, int width, int height, glm::vec3 lo, glm::vec3 hi,
-                            const glm::mat4& indexToWorld, bool empty);
+PixelOrder volumePixelOrder(const shared::GpuCamera& cam, int width, int height, const VolumeFootprint& volume);
 
 // Every pixel, in tile order, all inside.
 PixelOrder allPixels(int width, int height);

@@ -254,7 +254,7 @@ void Restir::setVolumes(const GpuVolumeResources& current, const GpuVolumeResour
   // Reprojection depth: the distance from the camera to the volume's centre (a per-frame
   // constant, so the history pixel never depends on a sample).
   const shared::GpuVolume& v = current.params();
-  volume_ = v;
+  footprint_ = current.footprint();
   const glm::vec3 centre = glm::vec3(v.indexToWorld * glm::vec4(0.5f * (v.boundsMin + v.boundsMax), 1.0f));
   centre_ = centre;
   currentSerial_ = current.serial();
@@ -305,9 +305,7 @@ void Restir::fillFrame(int frame, uint32_t sequence, uint32_t key) {
   // outside variants exist (otherwise all of them count as inside).
   if (pixelOrder_.pixels.empty() || !sameCamera(orderCam_, cam) || orderSerial_ != currentSerial_) {
     const int w = scene_.camera.width, h = scene_.camera.height;
-    pixelOrder_ = candidatesOut_ ? volumePixelOrder(cam, w, h, volume_.boundsMin, volume_.boundsMax,
-                                                    volume_.indexToWorld, volume_.empty != 0)
-                                 : allPixels(w, h);
+    pixelOrder_ = candidatesOut_ ? volumePixelOrder(cam, w, h, footprint_) : allPixels(w, h);
     paramBuffer_.upload(pixelOrder_.pixels.data(), pixelOrder_.pixels.size() * sizeof(uint32_t),
                         sizeof(shared::RestirParams));
     orderCam_ = cam;

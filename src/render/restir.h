@@ -131,7 +131,7 @@ class Restir {
   uint64_t renderedSerial_ = 0;                      // the volume the history was rendered with
   shared::GpuCamera prevCam_{};
   glm::vec3 centre_{0.0f};  // world centre of the volume's bounds (reprojection depth)
-  shared::GpuVolume volume_{};  // the current volume's parameters (its box, for pixelOrder_)
+  VolumeFootprint footprint_;  // where the current volume's density may be non-zero (pixelOrder_)
   // The frame's pixels, those that may see the volume first (render/pixel_order.h), and the
   // camera and volume they were found for (recomputed and uploaded when either changes).
   PixelOrder pixelOrder_;
