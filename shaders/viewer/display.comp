@@ -22,15 +22,28 @@ float disp_toneMap(float x) {
   return y <= 0.0031308 ? 12.92 * y : 1.055 * pow(y, 1.0 / 2.4) - 0.055;
 }
 
+// One invocation per source pixel: its colour is tone-mapped once and written to every window
+// pixel whose nearest source pixel it is (the window pixel p shows source pixel
+// floor((p + 0.5 - fit.xy) * fit.z), the test below, the same expression for every p). Tone mapping
+// per window pixel cost ~15 ms a frame at 1280x720 on lavapipe (three pow per pixel, 16 window
+// pixels per source pixel at the default fit); the border outside the fitted image is filled
+// black before this pass (viewer/display.cpp).
 void main() {
-  uvec2 p = gl_GlobalInvocationID.xy;
-  if (p.x >= pc.size.z || p.y >= pc.size.w) return;
-  vec2 s = (vec2(p) + 0.5 - pc.fit.xy) * pc.fit.z;
-  vec3 c = vec3(0.0);
-  if (s.x >= 0.0 && s.y >= 0.0 && s.x < float(pc.size.x) && s.y < float(pc.size.y)) {
-    c = src[2u * (uint(s.y) * pc.size.x + uint(s.x))].rgb * pc.fit.w;
-  }
+  uvec2 s = gl_GlobalInvocationID.xy;
+  if (s.x >= pc.size.x || s.y >= pc.size.y) return;
+  vec3 c = src[2u * (s.y * pc.size.x + s.x)].rgb * pc.fit.w;
   uvec3 b = uvec3(round(255.0 * vec3(disp_toneMap(c.r), disp_toneMap(c.g), disp_toneMap(c.b))));
   if (pc.flags.x != 0u) b = b.bgr;
-  dst[p.y * pc.size.z + p.x] = b.x | (b.y << 8u) | (b.z << 16u) | (255u << 24u);
+  uint packed = b.x | (b.y << 8u) | (b.z << 16u) | (255u << 24u);
+  // The window pixels that may map to s (one more on each side for rounding), clamped to the window.
+  vec2 lo = floor(vec2(s) / pc.fit.z + pc.fit.xy - 0.5) - 1.0;
+  vec2 hi = ceil(vec2(s + 1u) / pc.fit.z + pc.fit.xy - 0.5) + 1.0;
+  ivec2 p0 = ivec2(max(lo, vec2(0.0)));
+  ivec2 p1 = ivec2(min(hi, vec2(pc.size.zw)));
+  for (int y = p0.y; y < p1.y; ++y) {
+    for (int x = p0.x; x < p1.x; ++x) {
+      vec2 q = (vec2(x, y) + 0.5 - pc.fit.xy) * pc.fit.z;
+      if (q.x >= 0.0 && q.y >= 0.0 && uvec2(q) == s) dst[uint(y) * pc.size.z + uint(x)] = packed;
+    }
+  }
 }

@@ -40,7 +40,9 @@ void DisplayPass::record(VkCommandBuffer cmd, VkImage target, VkExtent2D extent,
   PLUME_CHECK_MSG(src_ != VK_NULL_HANDLE, "DisplayPass::record before setSource");
   const VkDeviceSize bytes = VkDeviceSize(extent.width) * extent.height * 4;
   if (!dst_.valid() || dst_.size() != bytes) {
-    dst_ = gpu::Buffer(ctx_, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT, "display target");
+    dst_ = gpu::Buffer(ctx_, bytes,
+                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                       "display target");
     pass_->set.bind(1, dst_);
   }
   // Fit the image into the window, aspect kept: `scale` source pixels per window pixel.
@@ -50,7 +52,12 @@ void DisplayPass::record(VkCommandBuffer cmd, VkImage target, VkExtent2D extent,
   push.fit = glm::vec4(0.5f * (float(extent.width) - float(srcWidth_) / scale),
                        0.5f * (float(extent.height) - float(srcHeight_) / scale), scale, std::exp2(exposureStops));
   push.flags = glm::uvec4(bgra ? 1u : 0u, 0u, 0u, 0u);
-  pass_->record(cmd, glm::uvec3(extent.width, extent.height, 1), &push, timer);
+  // Opaque black first, for the border the fitted image leaves: the pass writes only the window
+  // pixels that show a source pixel (one invocation per source pixel: shaders/viewer/display.comp).
+  // (A fill of the whole window costs nothing measurable next to the pass.)
+  vkCmdFillBuffer(cmd, dst_.handle(), 0, bytes, 0xff000000u);
+  gpu::computeBarrier(cmd);
+  pass_->record(cmd, glm::uvec3(uint32_t(srcWidth_), uint32_t(srcHeight_), 1), &push, timer);
   gpu::computeBarrier(cmd);
   gpu::imageBarrier(cmd, target, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0,
                VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);

@@ -1,5 +1,6 @@
-// The display step: the renderer's linear image -> tone map (shaders/viewer/display.comp) into a
-// packed 8-bit buffer the size of the window -> vkCmdCopyBufferToImage into the swapchain image.
+// The display step: the renderer's linear image -> tone map (shaders/viewer/display.comp, once per
+// image pixel, written to the window pixels that show it) into a packed 8-bit buffer the size of
+// the window -> vkCmdCopyBufferToImage into the swapchain image.
 // Also reads a presented image back (scripted tests compare it with the screenshot).
 #pragma once
 
