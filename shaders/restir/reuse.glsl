@@ -74,20 +74,13 @@ uvec2 rs_pair(uint t, uint count) {
 
 bool rs_has_sample(uint s) { return (in_.hasSample & (1u << s)) != 0u; }
 
-// PLUME_RS_OUTSIDE: the variant for pixels whose camera rays miss the volume (render/
-// pixel_order.h; scenes without surfaces). Its canonical input never holds a path (candidates
-// find none, and no shifted path has density at its first vertex there), and every target in
-// its domain is 0 for the same reason, so the variant evaluates none: the weights see the zeros
-// the walking variant computes, and the confidences add up as there.
 void rs_cross_targets() {
 #if !PLUME_RS_SAME_DOMAIN
   uint pairs = rs_pair_count(in_.count);
   for (uint t = 0u; t < pairs; ++t) {
     uvec2 sj = rs_pair(t, in_.count);
     float v = 0.0f;
-#ifndef PLUME_RS_OUTSIDE
     if (rs_has_sample(sj.x)) v = rs_target(rs_input_domain(sj.y), rs_input_set(sj.x), in_.pixel[sj.x]);
-#endif
     rsCross[sj.x * RS_MAX_INPUTS + sj.y] = v;
   }
 #endif
@@ -114,6 +107,18 @@ float rs_target_in(uint s, uint j) {
 #include "../shared/restir_mis.h"
 
 void rs_reuse(uint outSet, uint outPixel, inout RngState rng) {
+#ifdef PLUME_RS_OUTSIDE
+  // The variant for pixels whose camera rays miss the volume (render/pixel_order.h; scenes
+  // without surfaces). Every target in such a pixel's domain is 0 (no shifted path has density at
+  // its first vertex there) and its own input never holds a path, so every resampling weight is 0:
+  // the result is an empty reservoir whose confidence is the inputs' summed in their order, as
+  // rs_merge sums them in the walking variant. Nothing else of the step is compiled in.
+  RsReservoir empty = rs_empty();
+  for (uint s = 0u; s < in_.count; ++s) empty.M += in_.res[s].M;
+  rs_finalize(empty);
+  rs_clear_path(outSet, outPixel);
+  rs_store(outSet, outPixel, empty);
+#else
   float Msum = 0.0f;
   for (uint s = 0u; s < in_.count; ++s) Msum += in_.res[s].M;
   in_.hasSample = 0u;
@@ -143,6 +148,7 @@ void rs_reuse(uint outSet, uint outPixel, inout RngState rng) {
     rs_clear_path(outSet, outPixel);
   }
   rs_store(outSet, outPixel, out_);
+#endif
 }
 
 // The history pixel for `pixel` (DESIGN §4.2 step 5): the point at the fixed reprojection depth
