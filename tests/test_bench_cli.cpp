@@ -65,7 +65,7 @@ TEST(BenchCli, WritesTableCsvAndPlotWithSaneNumbersAndCachesTheReference) {
   copySmokeScene(sceneDir);
   const std::vector<std::string> args = {"bench", (sceneDir / "smoke.json").string(), "-o", (dir / "out").string(),
                                          "--width", "24", "--height", "24", "--ref-spp", "256", "--warmup", "2",
-                                         "--measure", "3", "--pt-spp", "1", "4", "--only", "pairwise M4 k3 r16", "R0",
+                                         "--measure", "3", "--pt-spp", "1", "4", "--only", "pairwise M4 k2 r16", "R0",
                                          "--cpu-ref-spp", "1", "16", "--save-images"};
   test::RunResult r = test::runPlume(args);
   ASSERT_EQ(r.exitCode, 0) << r.output;

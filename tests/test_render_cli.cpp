@@ -404,7 +404,7 @@ TEST(RenderCli, RestirShowsTheSameProgressAndHeaderAsThePathTracer) {
   EXPECT_EQ(r.meta["restir_history_from"], "4");
   EXPECT_EQ(r.meta["restir_iterations_averaged"], "2");  // spp 2: none settles
   EXPECT_EQ(r.meta["dropped_non_finite_reservoirs"], "0");
-  EXPECT_EQ(r.meta["restir"], "restir pairwise M4 k3 r2 R1 c20");
+  EXPECT_EQ(r.meta["restir"], "restir pairwise M4 k2 r2 R1 c20");
 }
 
 // docs/farm.md: a ReSTIR frame is determined by the frame its history starts from (the chunk's

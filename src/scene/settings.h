@@ -27,7 +27,8 @@ struct RenderSettings {
   // Volumetric ReSTIR (DESIGN §4.2; src/render/restir.h)
   int restirCandidates = 4;          // M: candidate paths per pixel and frame
   int restirCandidatesMoving = 0;    // ... in frames whose camera moved (0: restirCandidates)
-  int restirNeighbours = 3;          // k: spatial neighbours per round
+  int restirNeighbours = 2;          // k: spatial neighbours per round (2 beat 3 at equal time
+                                     // everywhere measured: notes/restir.md "Session 24")
   int restirRadius = 16;             // spatial neighbour radius, pixels
   int restirRounds = 1;              // R: spatial rounds (0 = no spatial reuse)
   int restirHistoryCap = 20;         // temporal confidence cap c: M_hist <= c * M_cur (0 = no temporal)
