@@ -248,16 +248,21 @@ TEST_F(GpuRestir, ManyLightsChosenByPowerMatchReference) {
   expectMatches(run, reference(s, grid, 512), "many_lights");
 }
 
+// The scene with its camera moved to `position` by `frame` (a key; the base pose before it).
+Scene movedBy(Scene s, int frame, glm::vec3 position) {
+  CameraKey key;
+  key.frame = frame;
+  key.pose = s.camera.base;
+  key.pose.position = position;
+  s.camera.keys.push_back(key);
+  return s;
+}
+
 // ReSTIR over four frames whose camera moves to a new pose by the last one, against the
 // reference of that pose.
 void expectMovingCameraMatches(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const RestirOptions& o,
                                const char* label) {
-  Scene s = baseScene(16);
-  CameraKey key;
-  key.frame = 4;
-  key.pose = s.camera.base;
-  key.pose.position = {1.6f, 1.3f, 3.4f};
-  s.camera.keys.push_back(key);
+  const Scene s = movedBy(baseScene(16), 4, {1.6f, 1.3f, 3.4f});
   auto grid = test::makeNoiseGrid(40, 1.0 / 20, 2);
   RunSpec spec;
   spec.framesPerRun = 4;
@@ -296,12 +301,7 @@ DifferingPixels differingPixels(gpu::Context& ctx, gpu::ShaderCompiler& compiler
     return n;
   };
   const Scene still = baseScene(16);
-  Scene moving = still;
-  CameraKey key;
-  key.frame = 3;
-  key.pose = still.camera.base;
-  key.pose.position = {1.3f, 1.3f, 3.5f};
-  moving.camera.keys.push_back(key);
+  const Scene moving = movedBy(still, 3, {1.3f, 1.3f, 3.5f});
   return {differ(still), differ(moving), size_t(still.camera.width) * size_t(still.camera.height)};
 }
 
@@ -363,12 +363,7 @@ TEST_F(GpuRestir, SameDomainTemporalPipelineMatchesTheGeneralOne) {
 TEST_F(GpuRestir, PixelsThatMissTheVolumeSkipTheWalksAndKeepTheImage) {
   Scene still = baseScene(24);
   still.camera.base.position = {1.0f, 1.2f, 7.5f};  // the grid's box covers part of the image
-  Scene moving = still;
-  CameraKey key;
-  key.frame = 4;
-  key.pose = still.camera.base;
-  key.pose.position = {2.4f, 1.6f, 7.0f};
-  moving.camera.keys.push_back(key);
+  const Scene moving = movedBy(still, 4, {2.4f, 1.6f, 7.0f});
   auto gridAt = [](int frame) { return test::makeNoiseGrid(40, 1.0 / 20, unsigned(10 + frame)); };
   // Two blobs 60 voxels apart, side by side in view: the box's middle is empty bricks, which the
   // footprint's occupied cells leave out.
@@ -379,11 +374,10 @@ TEST_F(GpuRestir, PixelsThatMissTheVolumeSkipTheWalksAndKeepTheImage) {
     for (auto it = other->cbeginValueOn(); it; ++it) acc.setValue(it.getCoord() + openvdb::Coord(60, 4, 0), *it);
     return grid;
   };
-  Scene sparse = moving;
-  sparse.camera.base.position = {2.0f, 0.7f, 6.5f};
-  sparse.camera.base.lookAt = {2.0f, 0.6f, 0.5f};
-  sparse.camera.keys[0].pose = sparse.camera.base;
-  sparse.camera.keys[0].pose.position = {2.6f, 1.0f, 6.3f};
+  Scene sparseBase = still;
+  sparseBase.camera.base.position = {2.0f, 0.7f, 6.5f};
+  sparseBase.camera.base.lookAt = {2.0f, 0.6f, 0.5f};
+  const Scene sparse = movedBy(sparseBase, 4, {2.6f, 1.0f, 6.3f});
   struct Case {
     const char* name;
     const Scene* scene;
