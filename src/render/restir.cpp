@@ -358,7 +358,7 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
     for (uint32_t m = 0; m < params_.candidates; m += params_.walksPerDispatch) {
       if (m > 0) gpu::computeBarrier(cmd);
       push.candidate = m;
-      over(*candidates_, push, 0, candidatesOut_ ? inside : all);
+      over(*candidates_, push, 0, inside);  // (every pixel is inside without the outside variants)
     }
     push.candidate = 0;
     if (candidatesOut_) over(*candidatesOut_, push, inside, all - inside);
@@ -428,7 +428,7 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
 uint32_t Restir::recordTail(VkCommandBuffer cmd, shared::RsPush push, uint32_t first) {
   // Over the pixels that may see the volume only: the outside variant of final shading ended
   // the others' walks (their camera rays escape).
-  const uint32_t count = candidatesOut_ ? pixelOrder_.inside : uint32_t(pixelOrder_.pixels.size());
+  const uint32_t count = pixelOrder_.inside;
   push.listBegin = 0;
   push.listCount = count;
   const uint32_t last = std::min(tailDispatches_, first + kTailDispatchesPerSubmit);
