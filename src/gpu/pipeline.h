@@ -93,6 +93,9 @@ class GpuTimer {
   uint32_t maxScopes_;
   std::vector<std::string> names_;
   bool supported_ = false;
+  uint32_t stampsPerScope_ = 2;  // begin, end; on CPU devices also a flushing stamp after each
+
+  void stamp(VkCommandBuffer cmd, VkPipelineStageFlagBits stage, uint32_t query);
 };
 
 // Full compute->compute, compute->transfer and compute->indirect-dispatch memory barrier.

@@ -308,6 +308,11 @@ int Viewer::run() {
     logInfo(strf("view: %d frames, %.2f ms/frame (%.1f fps) at %dx%d, window %ux%u, %s", o_.scriptedFrames,
                  stats_.frameMs, stats_.fps, stats_.width, stats_.height, swapchain_->extent().width,
                  swapchain_->extent().height, stats_.renderer.c_str()));
+    // The GPU passes of the last frame as the panel shows them (the renderer's, then the display's).
+    PassTimes passes = rendererTimes_;
+    const PassTimes display = displayTimer_->read();
+    passes.insert(passes.end(), display.begin(), display.end());
+    logInfo("view: last frame's passes: " + passTimesText(passes));
     if (!o_.screenshot.empty()) {
       saveScreenshot(o_.screenshot, renderer_->readImage(), renderer_->samplesSoFar(), s_, ctx_->deviceName(),
                      s_.scene.camera.poseAt(s_.frame));
