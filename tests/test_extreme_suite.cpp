@@ -122,8 +122,11 @@ TEST_F(ExtremeSuite, CameraInsideADenseMedium) {
   checkCase(ctx(), compiler(), caseNamed("camera_inside", {16, 256}), {});
 }
 
+// 512 ReSTIR runs: with two spatial neighbours (the default since session 24) 128 runs left one
+// pixel at z -5.11, a rare bright event seen too seldom (512 runs: worst pixel z -3.03, the
+// aggregate z <= 1.07; notes/restir.md "Session 25").
 TEST_F(ExtremeSuite, SingleVoxelInEmptySpace) {
-  checkCase(ctx(), compiler(), caseNamed("single_voxel", {16, 256}), {});
+  checkCase(ctx(), compiler(), caseNamed("single_voxel", {16, 256}), {512, 1024, 512});
 }
 
 TEST_F(ExtremeSuite, EmptyGridShowsTheEnvironmentInEveryEstimator) {

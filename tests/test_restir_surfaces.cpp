@@ -67,7 +67,9 @@ TEST_F(GpuRestirSurfaces, LampsSeenDirectlyMatchReference) {
   reuse.historyCap = 20;
   test::expectRestirMatchesReference(ctx(), compiler(), s, grid, 256, 16384, "lamps_seen_directly_history",
                                      {shared::RS_MIS_PAIRWISE, shared::RS_MIS_GBH}, reuse, 3);
-  test::expectRestirMatchesReference(ctx(), compiler(), s, grid, 128, 16384, "lamps_seen_directly_one_frame",
+  // 512 runs for the one-frame pass: with two spatial neighbours 128 runs left one pixel at z
+  // -4.72 (512: -2.84; notes/restir.md "Session 25").
+  test::expectRestirMatchesReference(ctx(), compiler(), s, grid, 512, 16384, "lamps_seen_directly_one_frame",
                                      {shared::RS_MIS_PAIRWISE});
   // A denser grid before: the lamps behind the cloud are dimmer in the history's target.
   auto before = test::makeNoiseGrid(32, 1.0 / 16, 8);

@@ -32,8 +32,7 @@ namespace plume {
 struct RestirOptions {
   int candidates = 4;        // M
   int candidatesMoving = 0;  // M while the camera moves (0: candidates)
-  int neighbours = 3;        // k (the tests' default: their run counts were designed with 3;
-                             // scenes default to render.restir_neighbours, 2)
+  int neighbours = 2;        // k (as render.restir_neighbours)
   int radius = 16;           // px
   int rounds = 1;            // R (0: no spatial reuse)
   int historyCap = 20;       // c (0: no temporal reuse)

@@ -29,7 +29,7 @@ inline Image restirCheckReference(Scene s, openvdb::FloatGrid::Ptr grid,
   return ref::renderReference(s, grid, opt);
 }
 
-// One spatial round (k 3, radius 4), no history, MIS kind mis.
+// One spatial round (k 2, radius 4), no history, MIS kind mis.
 inline RestirOptions spatialReuse(uint32_t mis) {
   RestirOptions o;
   o.rounds = 1;
