@@ -7,6 +7,7 @@
 // seed sequence), so samples are independent and the variance of the mean is estimated honestly
 // even with temporal reuse; so is that of the image mean, from each run's image mean, though
 // spatial reuse correlates the pixels of a run.
+#include "core/error.h"
 #include "media/vdb_loader.h"
 #include "reference/reference.h"
 #include "render/gpu_scene.h"
@@ -627,4 +628,34 @@ TEST_F(GpuRestir, AcceptsAnyMaxBouncesWithFixedMemory) {
   for (float v : run.mean.rgb) EXPECT_TRUE(std::isfinite(v));
   EXPECT_EQ(run.dropped, 0u);
   EXPECT_EQ(run.truncated, 0u);
+}
+
+// An image whose per-pixel buffers exceed the device's largest storage buffer (lavapipe's 128 MiB
+// at 1920x1080 with 8 bounces) is bad input: an InputError before anything is compiled or
+// allocated, naming the buffer, the most pixels that fit and an image of the same aspect that does
+// (gpu::requirePerPixelStorage). The size is made from this device's limit, so the test is the
+// same on any device; the suggested image is checked against the limit it was made from.
+TEST_F(GpuRestir, ImageTooLargeForTheDeviceIsAClearErrorBeforeCompiling) {
+  Scene s = baseScene(8);
+  s.render.maxBounces = 8;
+  RestirOptions o;
+  o.prefix = 8;  // 7 stored vertices a path: 3 sets x 7 x 16 = 336 bytes a pixel
+  const double limit = double(ctx().limits().maxStorageBufferRange);
+  const double pixels = 1.5 * limit / 336.0;
+  s.camera.width = int(std::ceil(std::sqrt(pixels * 16.0 / 9.0)));
+  s.camera.height = int(std::ceil(std::sqrt(pixels * 9.0 / 16.0)));
+  try {
+    Restir restir(ctx(), compiler(), s, o);
+    FAIL() << "a " << s.camera.width << "x" << s.camera.height << " image was accepted";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("reservoir path vertices (336 bytes a pixel)"), std::string::npos) << m;
+    const size_t at = m.find("e.g. ");
+    ASSERT_NE(at, std::string::npos) << m;
+    int w = 0, h = 0;
+    ASSERT_EQ(std::sscanf(m.c_str() + at, "e.g. %dx%d", &w, &h), 2) << m;
+    EXPECT_LE(double(w) * h * 336.0, limit) << m;
+    EXPECT_GT(double(w) * h * 336.0, 0.98 * limit) << m;
+    EXPECT_NEAR(double(w) / h, 16.0 / 9.0, 0.01) << m;
+  }
 }

@@ -4,6 +4,9 @@
 #include "core/log.h"
 #include "gpu/check.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include <cstring>
 #include <utility>
 
@@ -243,6 +246,25 @@ void Image3D::upload(const void* data, size_t bytes) {
                  VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
                  VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
   });
+}
+
+void requirePerPixelStorage(const Context& ctx, const std::string& what,
+                            const std::vector<std::pair<std::string, size_t>>& bytesPerPixel, int width, int height,
+                            const std::string& remedy) {
+  const VkDeviceSize limit = ctx.limits().maxStorageBufferRange;
+  const size_t pixels = size_t(width) * size_t(height);
+  for (const auto& [name, bytes] : bytesPerPixel) {
+    if (bytes == 0 || VkDeviceSize(pixels) * bytes <= limit) continue;
+    const size_t most = size_t(limit / bytes);
+    // The largest image of this aspect with at most `most` pixels.
+    const double scale = std::sqrt(double(most) / double(pixels));
+    int w = std::max(1, int(width * scale)), h = std::max(1, int(height * scale));
+    while (size_t(w) * h > most && w > 1 && h > 1) --(w >= h ? w : h);
+    throw InputError(strf("%s: %s at %dx%d needs %.1f MiB for its %s (%zu bytes a pixel), more than the device's "
+                          "largest storage buffer (%.1f MiB): at most %zu pixels on this device, e.g. %dx%d; %s",
+                          ctx.deviceName().c_str(), what.c_str(), width, height, double(pixels * bytes) / 1048576.0,
+                          name.c_str(), bytes, double(limit) / 1048576.0, most, w, h, remedy.c_str()));
+  }
 }
 
 void imageBarrier(VkCommandBuffer cmd, VkImage image, VkImageLayout from, VkImageLayout to, VkAccessFlags srcAccess,

@@ -10,6 +10,8 @@
 
 #include <cstddef>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace plume::gpu {
 
@@ -98,6 +100,15 @@ class Image3D {
   glm::ivec3 extent_{0};
   size_t texelBytes_ = 0;
 };
+
+// The storage buffers an estimator allocates per pixel of a width x height image, (name, bytes per
+// pixel) each: every one must fit the device's largest storage buffer (maxStorageBufferRange;
+// lavapipe 128 MiB). Otherwise throws InputError naming `what`, the buffer that does not fit, the
+// most pixels that do, an image of the same aspect that fits, and `remedy` (what else the user can
+// change), before anything is compiled or allocated.
+void requirePerPixelStorage(const Context& ctx, const std::string& what,
+                            const std::vector<std::pair<std::string, size_t>>& bytesPerPixel, int width, int height,
+                            const std::string& remedy);
 
 // A layout transition of a whole single-mip colour image.
 void imageBarrier(VkCommandBuffer cmd, VkImage image, VkImageLayout from, VkImageLayout to, VkAccessFlags srcAccess,

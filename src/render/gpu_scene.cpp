@@ -92,10 +92,11 @@ shared::GpuFrame gpuFrame(const Scene& scene, int frame, uint32_t seed, uint32_t
   return f;
 }
 
-Image readAccumulation(const gpu::Buffer& accum, int width, int height) {
+namespace {
+
+// The image (mean and variance of the mean) of accumulation data, 2 vec4 per pixel.
+Image accumulationImage(const std::vector<glm::vec4>& data, int width, int height) {
   const size_t pixels = size_t(width) * height;
-  std::vector<glm::vec4> data(2 * pixels);
-  accum.download(data.data(), data.size() * sizeof(glm::vec4));
   Image image(width, height, true);
   for (size_t i = 0; i < pixels; ++i) {
     const glm::vec4 mean = data[2 * i];
@@ -107,6 +108,24 @@ Image readAccumulation(const gpu::Buffer& accum, int width, int height) {
     image.setVariance(x, y, varMean);
   }
   return image;
+}
+
+}  // namespace
+
+Image readAccumulation(const std::vector<gpu::Buffer>& bands, uint32_t bandPixels, int width, int height) {
+  const size_t pixels = size_t(width) * height;
+  std::vector<glm::vec4> data(2 * pixels);
+  for (size_t b = 0; b < bands.size(); ++b) {
+    const size_t begin = b * bandPixels, n = std::min<size_t>(bandPixels, pixels - begin);
+    bands[b].download(data.data() + 2 * begin, n * 2 * sizeof(glm::vec4));
+  }
+  return accumulationImage(data, width, height);
+}
+
+Image readAccumulation(const gpu::Buffer& accum, int width, int height) {
+  std::vector<glm::vec4> data(2 * size_t(width) * height);
+  accum.download(data.data(), data.size() * sizeof(glm::vec4));
+  return accumulationImage(data, width, height);
 }
 
 gpu::BindingTypes sceneBindingTypes(bool restir, bool emission, bool surfaces, uint32_t surfaceShift) {

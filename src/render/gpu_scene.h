@@ -37,5 +37,7 @@ gpu::BindingTypes sceneBindingTypes(bool restir, bool emission, bool surfaces, u
 // A progressive accumulation buffer (per pixel: vec4(mean rgb, n), vec4(M2 rgb, 0), Welford's
 // update on the GPU) read back as the mean and the variance of the mean.
 Image readAccumulation(const gpu::Buffer& accum, int width, int height);
+// The same from an accumulation split into buffers of bandPixels pixels each (the last one shorter).
+Image readAccumulation(const std::vector<gpu::Buffer>& bands, uint32_t bandPixels, int width, int height);
 
 }  // namespace plume

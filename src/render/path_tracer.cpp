@@ -17,7 +17,8 @@ namespace {
 constexpr uint32_t kBouncesPerSubmit = 16;  // extension + shading rounds recorded per submission
 }  // namespace
 
-PathTracer::PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene, bool kernelCounters)
+PathTracer::PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene, bool kernelCounters,
+                       VkDeviceSize bufferLimit)
     : ctx_(ctx), scene_(scene), features_(featuresOf(scene)), compiler_(compiler),
       timer_(ctx, 2 * kBouncesPerSubmit + 1) {
   features_.kernelCounters = kernelCounters;
@@ -31,17 +32,44 @@ PathTracer::PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const S
   frameBuffer_ = gpu::Buffer(ctx, sizeof(shared::GpuFrame), storage, "frame parameters");
   std::vector<shared::GpuLight> lights = gpuLights(scene);
   lightBuffer_ = lightTexels(ctx, lights);
-  accum_ = gpu::Buffer(ctx, pixels * 2 * sizeof(glm::vec4), storage, "accumulation");
   // Whole samples of every pixel per generation, about kGenerationPaths paths, so that a small
-  // image's samples share the rounds' dispatches and the resolve; a large image (more pixels than
-  // kMaxSlots) goes in bands of kMaxSlots pixels, one sample each.
-  slots_ = pixels >= kMaxSlots ? kMaxSlots : uint32_t(std::max<size_t>(1, kGenerationPaths / pixels) * pixels);
+  // image's samples share the rounds' dispatches and the resolve; a larger image goes in bands of
+  // kGenerationPaths pixels with up to kMaxSlots / kGenerationPaths samples each (one sample per
+  // band of kMaxSlots pixels, until session 25, cost its resolve ~43 ns a pixel and sample on
+  // lavapipe, ~20% of a 1024² frame; four per band amortise the resolve's invocations).
+  if (pixels <= kGenerationPaths) {
+    bandPixels_ = uint32_t(std::max<size_t>(pixels, 1));
+    slots_ = uint32_t(std::max<size_t>(1, kGenerationPaths / bandPixels_) * bandPixels_);
+  } else {
+    bandPixels_ = kGenerationPaths;
+    slots_ = kMaxSlots;
+  }
+  // The accumulation (32 bytes a pixel) in as few buffers as the device's largest storage buffer
+  // allows (lavapipe: 128 MiB, 4.2 megapixels; a 3840x2160 image needs two), each a whole number
+  // of generation bands, so that a generation's pixels lie in one buffer.
+  const VkDeviceSize limit = bufferLimit > 0 ? bufferLimit : ctx.limits().maxStorageBufferRange;
+  constexpr VkDeviceSize kAccumBytes = 2 * sizeof(glm::vec4);
+  const VkDeviceSize bandsPerBuffer = limit / (kAccumBytes * bandPixels_);
+  if (bandsPerBuffer == 0) {
+    throw InputError(strf("%s: the path tracer's accumulation band of %u pixels needs %.1f MiB, more than the "
+                          "device's storage buffer limit of %.1f MiB", ctx.deviceName().c_str(), bandPixels_,
+                          double(bandPixels_ * kAccumBytes) / 1048576.0, double(limit) / 1048576.0));
+  }
+  accumPixels_ = uint32_t(std::min<VkDeviceSize>(bandsPerBuffer * bandPixels_, std::max<size_t>(pixels, 1)));
+  for (size_t begin = 0; begin < std::max<size_t>(pixels, 1); begin += accumPixels_) {
+    const size_t n = std::min<size_t>(accumPixels_, pixels - begin);
+    accums_.emplace_back(ctx, std::max<size_t>(n, 1) * kAccumBytes, storage,
+                         n == pixels ? std::string("accumulation") : strf("accumulation part %zu", accums_.size()));
+  }
   paths_ = gpu::Buffer(ctx, size_t(slots_) * shared::PT_PATH_BYTES, storage, "path slots");
   queues_ = gpu::Buffer(ctx, size_t(slots_) * 2 * sizeof(uint32_t), storage, "path queues");
   wave_ = gpu::Buffer(ctx, sizeof(shared::PtWave), storage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, "path queue lengths");
   const gpu::ShaderDefines none;
   queue_ = makePass("passes/pt_queue.comp", none, "pt queues", false);
-  resolve_ = makePass("passes/pt_resolve.comp", none, "pt resolve", false);
+  for (const gpu::Buffer& band : accums_) {
+    resolves_.push_back(makePass("passes/pt_resolve.comp", none, "pt resolve", false));
+    resolves_.back()->set.bind(shared::BIND_PT_ACCUM, band);
+  }
   active_ = &tracking(false);
 }
 
@@ -65,7 +93,7 @@ std::unique_ptr<gpu::ComputePass> PathTracer::makePass(const std::string& file, 
                                                  uint32_t(sizeof(shared::PtPush)), name,
                                                  glm::uvec3(shared::PT_WAVE_GROUP, 1, 1));
   pass->set.bind(shared::BIND_FRAME, frameBuffer_);
-  pass->set.bind(shared::BIND_PT_ACCUM, accum_);
+  pass->set.bind(shared::BIND_PT_ACCUM, accums_[0]);  // the resolve passes rebind their band
   pass->set.bind(shared::BIND_PT_PATHS, paths_);
   pass->set.bind(shared::BIND_PT_QUEUES, queues_);
   pass->set.bind(shared::BIND_PT_WAVE, wave_);
@@ -105,7 +133,7 @@ void PathTracer::setVolume(const GpuVolumeResources& volume) {
 
 void PathTracer::beginFrame(int frame) {
   frame_ = gpuFrame(scene_, frame, uint32_t(scene_.render.seed), uint32_t(frame));
-  accum_.fillZero();
+  for (gpu::Buffer& band : accums_) band.fillZero();
   samples_ = 0;
 }
 
@@ -174,9 +202,13 @@ void PathTracer::traceGeneration(uint32_t pixelBegin, uint32_t pixels, uint32_t 
     // A path still queued after max_bounces + 1 extensions would be a bug in the kernels.
     PLUME_CHECK_MSG(extensions < maxExtensions, "path tracer: paths left after max_bounces + 1 extensions");
   }
+  // The accumulation buffer that holds these pixels, indexed from its first.
+  const uint32_t part = pixelBegin / accumPixels_;
+  PLUME_CHECK(part < accums_.size() && (pixelBegin + pixels - 1) / accumPixels_ == part);
+  push.pixelBegin = pixelBegin - part * accumPixels_;
   ctx_.submitAndWait([&](VkCommandBuffer cmd) {
     timer_.reset(cmd);
-    resolve_->record(cmd, glm::uvec3(pixels, 1, 1), &push, &timer_);
+    resolves_[part]->record(cmd, glm::uvec3(pixels, 1, 1), &push, &timer_);
   });
   addTimes();
 }
@@ -190,23 +222,29 @@ void PathTracer::addSamples(int spp) {
   const uint32_t pixels = uint32_t(scene_.camera.width) * uint32_t(scene_.camera.height);
   passTimes_.clear();
   for (uint32_t done = 0; done < uint32_t(spp);) {
-    if (pixels <= slots_) {
-      const uint32_t n = std::min(uint32_t(spp) - done, samplesPerGeneration());
-      traceGeneration(0u, pixels, done, n);
-      done += n;
-    } else {
-      for (uint32_t begin = 0; begin < pixels; begin += slots_) traceGeneration(begin, std::min(slots_, pixels - begin), done, 1u);
-      done += 1;
+    const uint32_t n = std::min(uint32_t(spp) - done, samplesPerGeneration());
+    for (uint32_t begin = 0; begin < pixels; begin += bandPixels_) {
+      traceGeneration(begin, std::min(bandPixels_, pixels - begin), done, n);
     }
+    done += n;
   }
   samples_ += spp;
 }
 
-uint32_t PathTracer::samplesPerGeneration() const {
-  const uint32_t pixels = uint32_t(scene_.camera.width) * uint32_t(scene_.camera.height);
-  return pixels <= slots_ ? slots_ / pixels : 1u;
+uint32_t PathTracer::samplesPerGeneration() const { return slots_ / bandPixels_; }
+
+Image PathTracer::readImage() const {
+  return readAccumulation(accums_, accumPixels_, scene_.camera.width, scene_.camera.height);
 }
 
-Image PathTracer::readImage() const { return readAccumulation(accum_, scene_.camera.width, scene_.camera.height); }
+const gpu::Buffer& PathTracer::accumulation() const {
+  if (accums_.size() != 1) {
+    throw InputError(strf("%s: a %dx%d image's accumulation is split into %zu buffers (the device's storage buffer "
+                          "limit): the viewer shows images of up to %u pixels on this device",
+                          ctx_.deviceName().c_str(), scene_.camera.width, scene_.camera.height, accums_.size(),
+                          accumPixels_));
+  }
+  return accums_[0];
+}
 
 }  // namespace plume

@@ -22,8 +22,11 @@ namespace plume {
 
 class PathTracer {
  public:
-  // kernelCounters: FeatureSet::kernelCounters (the kernel benchmark only).
-  PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene, bool kernelCounters = false);
+  // kernelCounters: FeatureSet::kernelCounters (the kernel benchmark only). bufferLimit: the
+  // largest storage buffer to allocate (0: the device's maxStorageBufferRange; tests set less to
+  // split a small image's accumulation into bands).
+  PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene, bool kernelCounters = false,
+             VkDeviceSize bufferLimit = 0);
 
   const FeatureSet& features() const { return features_; }
   bool hasSurfaces() const { return surfaces_ != nullptr; }  // a BVH was built (the scene has surfaces)
@@ -36,20 +39,26 @@ class PathTracer {
   void beginFrame(int frame);
   // Traces `spp` more samples per pixel (waits for them).
   void addSamples(int spp);
-  // Path slots per generation (samples of several pixels traced together): at most kMaxSlots, and
-  // whole samples of the image up to about kGenerationPaths. One sample per generation made each
+  // Path slots per generation (samples of several pixels traced together): whole samples of the
+  // image up to about kGenerationPaths; a larger image in bands of kGenerationPaths pixels with up
+  // to kMaxSlots / kGenerationPaths samples each (path_tracer.cpp). One sample per generation made each
   // sample pay ~max_bounces rounds of dispatches and a resolve pass: on lavapipe 2^18 paths took
   // the bundled smoke's 128² path tracer from ~7.7 to ~4.3 ms per sample and 256² by ~20%
   // (notes/bench/kernels.md "Session 20"); 2^20 was no faster than 2^18.
   static constexpr uint32_t kMaxSlots = 1u << 20;
   static constexpr uint32_t kGenerationPaths = 1u << 18;
   int samplesSoFar() const { return samples_; }
-  // Samples of every pixel that one generation holds (1 where the image is split into bands).
+  // Samples of every pixel of its band that one generation holds.
   uint32_t samplesPerGeneration() const;
+  // Pixels per generation: the whole image, or bands of kGenerationPaths pixels.
+  uint32_t generationPixels() const { return bandPixels_; }
   Image readImage() const;  // mean + variance of the mean
   // The accumulation on the device (render/gpu_scene.h readAccumulation's layout), for a display
-  // pass that reads it in place.
-  const gpu::Buffer& accumulation() const { return accum_; }
+  // pass that reads it in place. Throws InputError where the image needs more than one band.
+  const gpu::Buffer& accumulation() const;
+  // Buffers the accumulation is split into (a whole number of generation bands each): one unless
+  // the image's accumulation exceeds the device's largest storage buffer.
+  size_t accumulationBands() const { return accums_.size(); }
   const PassTimes& lastPassTimes() const { return passTimes_; }
 
  private:
@@ -73,10 +82,14 @@ class PathTracer {
   gpu::ShaderCompiler& compiler_;
   Tracking tracking_[2];  // [skip empty space]
   Tracking* active_ = nullptr;
-  std::unique_ptr<gpu::ComputePass> queue_, resolve_;
+  std::unique_ptr<gpu::ComputePass> queue_;
+  std::vector<std::unique_ptr<gpu::ComputePass>> resolves_;  // one per accumulation band
   bool skipEmpty_ = false;
   gpu::GpuTimer timer_;
-  gpu::Buffer frameBuffer_, accum_;
+  gpu::Buffer frameBuffer_;
+  std::vector<gpu::Buffer> accums_;  // the accumulation in parts of accumPixels_ pixels
+  uint32_t accumPixels_ = 0;
+  uint32_t bandPixels_ = 0;           // pixels per generation
   gpu::TexelBuffer lightBuffer_;
   gpu::Buffer paths_, queues_, wave_;  // the wavefront's path slots, queues and PtWave
   uint32_t slots_ = 0;                 // path slots allocated

@@ -118,6 +118,20 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   const int emitting = std::min({scene.render.maxBounces + 1, prefix + 1, int(shared::RS_MAX_VERTICES)});
   const bool tail = scene.render.maxBounces > prefix || (endsInEmission && scene.render.maxBounces + 1 > emitting);
   const int vertices = endsInEmission ? emitting : prefix;  // stored per path
+  // Every per-pixel buffer below in one storage binding (session 25: at 1920x1080 lavapipe's
+  // 128 MiB held none of the three largest), checked before anything is compiled.
+  {
+    const size_t stride = size_t(std::max(1, vertices - 1));
+    const size_t slots = 2 + shared::RS_STATE_SLOTS + (features_.emitters ? shared::RS_LAMP_SLOTS : 0);
+    gpu::requirePerPixelStorage(
+        ctx, "ReSTIR", {{"reservoir path vertices", kSets * stride * sizeof(glm::vec4)},
+                        {"accumulation and pass state", slots * sizeof(glm::vec4)},
+                        {"reservoir paths", kSets * sizeof(shared::RsPathHead)},
+                        {"reservoirs", kSets * sizeof(shared::RsPacked)}},
+        scene.camera.width, scene.camera.height,
+        "fewer bounces keep fewer vertices a path (render.max_bounces, render.restir_prefix); --mode pt renders "
+        "large images in parts; or a device with larger limits (--device)");
+  }
   if (options_.neighbours > int(shared::RS_MAX_NEIGHBOURS)) {
     throw InputError(scene.path + strf(": render.restir_neighbours: at most %u", shared::RS_MAX_NEIGHBOURS));
   }
