@@ -2,15 +2,17 @@
 // sRGB encoding as the PNG previews (src/io/image.cpp toneMap) -> 8-bit pixels in the swapchain's
 // byte order, fitted into the window (aspect kept, nearest neighbour, black borders). The output
 // buffer is copied into the swapchain image with vkCmdCopyBufferToImage. On lavapipe the cost is
-// per invocation: one per window pixel (a gather) cost 8.8 ms a frame at 320x180 in 1280x720,
-// one per source pixel testing a 6 x 6 neighbourhood 5.5 ms, one per source pixel writing its
-// solved block 3.8 ms (docs/viewer.md).
+// per invocation and per store: one invocation per window pixel (a gather) cost 8.8 ms a frame at
+// 320x180 in 1280x720, one per source pixel testing a 6 x 6 neighbourhood 5.5 ms, one per source
+// pixel writing its solved block 3.8 ms, and with a 16-byte store per row of a 4-wide block
+// ~2.6 ms (host-timed with the fill and the copy; docs/viewer.md).
 #version 450
 layout(local_size_x = 16, local_size_y = 16) in;
 
 // The renderer's accumulation: [2 * pixel] = (mean rgb, n), [2 * pixel + 1] = (M2 rgb, 0); row 0 at top.
 layout(std430, binding = 0) readonly buffer Source { vec4 src[]; };
 layout(std430, binding = 1) writeonly buffer Target { uint dst[]; };  // one packed pixel per texel
+layout(std430, binding = 1) writeonly buffer Target4 { uvec4 dst4[]; };  // the same, four at a time
 
 layout(push_constant) uniform Push {
   uvec4 size;  // source width, height; target width, height
@@ -57,7 +59,12 @@ void main() {
   // the per-pixel rule floor(q) == s does), clamped to the window.
   ivec2 p0 = ivec2(disp_first(float(s.x), pc.fit.x, pc.size.z), disp_first(float(s.y), pc.fit.y, pc.size.w));
   ivec2 p1 = ivec2(disp_first(float(s.x + 1u), pc.fit.x, pc.size.z), disp_first(float(s.y + 1u), pc.fit.y, pc.size.w));
-  for (int y = p0.y; y < p1.y; ++y) {
-    for (int x = p0.x; x < p1.x; ++x) dst[uint(y) * pc.size.z + uint(x)] = packed;
+  if (p1.x - p0.x == 4 && (p0.x & 3) == 0 && (pc.size.z & 3u) == 0u) {
+    // Blocks four pixels wide on a four-pixel grid (the default window's fit): one 16-byte store a row.
+    for (int y = p0.y; y < p1.y; ++y) dst4[(uint(y) * pc.size.z + uint(p0.x)) >> 2u] = uvec4(packed);
+  } else {
+    for (int y = p0.y; y < p1.y; ++y) {
+      for (int x = p0.x; x < p1.x; ++x) dst[uint(y) * pc.size.z + uint(x)] = packed;
+    }
   }
 }
