@@ -31,8 +31,12 @@ layout(std430, binding = BIND_RS_RESERVOIRS) buffer ReservoirBuffer { RsPacked r
 // Path heads as stored: two uvec4 per RsPathHead (its C++ layout), loaded and stored whole by
 // rs_load_head / rs_store_head (restir/bridge.glsl): two vector accesses instead of one per field.
 layout(std430, binding = BIND_RS_PATHS) buffer PathBuffer { uvec4 rsPathWords[]; };
-// Vertices 2..n of each stored path: [(set * pixels + pixel) * stride + i - 2] = (w_i, t_i).
-layout(std430, binding = BIND_RS_BOUNCES) buffer BounceBuffer { vec4 rsBounces[]; };
+// Vertices 2..n of each stored path: texel (set * pixels + pixel) * stride + i - 2 = (w_i, t_i).
+// A storage texel buffer: its limit is maxTexelBufferElements texels (lavapipe: 2^27, 2 GiB of
+// rgba32f), not maxStorageBufferRange (lavapipe: 128 MiB, 0.4 megapixels at 8 bounces).
+layout(rgba32f, binding = BIND_RS_BOUNCES) uniform imageBuffer rsBounceTexels;
+vec4 rs_bounce(uint i) { return imageLoad(rsBounceTexels, int(i)); }
+void rs_set_bounce(uint i, vec4 v) { imageStore(rsBounceTexels, int(i), v); }
 // Progressive accumulation of final shading: [2 * pixel] = (mean rgb, n), [2 * pixel + 1] = (M2 rgb, 0);
 // then RS_STATE_SLOTS per pixel of the passes' state between dispatches (bridge.glsl rs_state_slot).
 layout(std430, binding = BIND_RS_OUTPUT) buffer OutputBuffer { vec4 rsOutput[]; };

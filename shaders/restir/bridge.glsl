@@ -294,7 +294,7 @@ void rs_copy_path(uint srcSet, uint srcPixel, uint dstSet, uint dstPixel) {
   rsPathWords[d + 1u] = rsPathWords[s + 1u];
   uint a = rs_bounce_base(srcSet, srcPixel);
   uint b = rs_bounce_base(dstSet, dstPixel);
-  for (uint i = 1u; i < head.w; ++i) rsBounces[b + i - 1u] = rsBounces[a + i - 1u];
+  for (uint i = 1u; i < head.w; ++i) rs_set_bounce(b + i - 1u, rs_bounce(a + i - 1u));
 }
 
 // --- The reconnection shift ----------------------------------------------------------------------
@@ -355,7 +355,7 @@ vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool unbiased, 
 #endif
     vec4 b = vec4(0.0f);
     if (i >= 2u) {
-      b = rsBounces[base + i - 2u];
+      b = rs_bounce(base + i - 2u);
       vec3 dir = b.xyz;
 #ifdef PLUME_RS_RECONNECT
       vec3 p = vec3(0.0f);

@@ -336,7 +336,7 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
     if (next && j < walkVertices) {
       ++j;
     } else {
-      for (uint i = 0u; i + 2u <= keep; ++i) rsBounces[base + i] = walk[i];
+      for (uint i = 0u; i + 2u <= keep; ++i) rs_set_bounce(base + i, walk[i]);
       ++m;
       j = 0u;
     }

@@ -15,6 +15,7 @@ VkDescriptorType descriptorType(BindingType t) {
     case BindingType::UniformBuffer: return VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
     case BindingType::SampledImage: return VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
     case BindingType::TexelBuffer: return VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
+    case BindingType::StorageTexelBuffer: return VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER;
   }
   return VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
 }
@@ -123,7 +124,7 @@ void DescriptorSet::bind(uint32_t binding, const Image3D& image) {
 
 void DescriptorSet::bind(uint32_t binding, const TexelBuffer& buffer) {
   const VkBufferView view = buffer.view();
-  write(binding, {BindingType::TexelBuffer}, nullptr, nullptr, &view);
+  write(binding, {BindingType::TexelBuffer, BindingType::StorageTexelBuffer}, nullptr, nullptr, &view);
 }
 
 GpuTimer::GpuTimer(Context& ctx, uint32_t maxScopes) : ctx_(ctx), maxScopes_(maxScopes) {

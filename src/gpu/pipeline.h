@@ -18,7 +18,7 @@ namespace plume::gpu {
 
 // StorageBuffer: read-write arrays. UniformBuffer: a small parameter block that every lane reads
 // at the same place (std140). TexelBuffer: a read-only array read per lane (gpu::TexelBuffer).
-enum class BindingType { StorageBuffer, UniformBuffer, SampledImage, TexelBuffer };
+enum class BindingType { StorageBuffer, UniformBuffer, SampledImage, TexelBuffer, StorageTexelBuffer };
 
 // A pass's binding table: bindings 0 .. count-1 are storage buffers except those listed with
 // another type (binding numbers are named in shaders/shared/bindings.h).

@@ -114,7 +114,8 @@ void Buffer::fillZero() {
 }
 
 // ---------------------------------------------------------------------------------------------
-TexelBuffer::TexelBuffer(Context& ctx, const void* data, size_t count, VkFormat format, const std::string& name)
+TexelBuffer::TexelBuffer(Context& ctx, const void* data, size_t count, VkFormat format, const std::string& name,
+                         bool storage)
     : ctx_(&ctx) {
   PLUME_CHECK(format == VK_FORMAT_R32_SFLOAT || format == VK_FORMAT_R32_UINT ||
               format == VK_FORMAT_R32G32B32A32_SFLOAT || format == VK_FORMAT_R32G32B32A32_UINT);
@@ -126,7 +127,8 @@ TexelBuffer::TexelBuffer(Context& ctx, const void* data, size_t count, VkFormat 
                           ctx.deviceName().c_str(), name.c_str(), count, ctx.limits().maxTexelBufferElements,
                           kTooLargeHint));
   }
-  buffer_ = Buffer(ctx, count * texelBytes, VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT, name);
+  buffer_ = Buffer(ctx, count * texelBytes,
+                   storage ? VK_BUFFER_USAGE_STORAGE_TEXEL_BUFFER_BIT : VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT, name);
   if (data && given > 0) buffer_.upload(data, given * texelBytes);
   VkBufferViewCreateInfo vi{VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO};
   vi.buffer = buffer_.handle();
@@ -248,22 +250,28 @@ void Image3D::upload(const void* data, size_t bytes) {
   });
 }
 
-void requirePerPixelStorage(const Context& ctx, const std::string& what,
-                            const std::vector<std::pair<std::string, size_t>>& bytesPerPixel, int width, int height,
-                            const std::string& remedy) {
-  const VkDeviceSize limit = ctx.limits().maxStorageBufferRange;
+void requirePerPixelStorage(const Context& ctx, const std::string& what, const PerPixelBuffers& buffers, int width,
+                            int height, const std::string& remedy) {
   const size_t pixels = size_t(width) * size_t(height);
-  for (const auto& [name, bytes] : bytesPerPixel) {
-    if (bytes == 0 || VkDeviceSize(pixels) * bytes <= limit) continue;
-    const size_t most = size_t(limit / bytes);
+  auto check = [&](const std::string& name, size_t perPixel, uint64_t limit, const char* unit, const char* kind,
+                   double unitScale, const char* scaled) {
+    if (perPixel == 0 || uint64_t(pixels) * perPixel <= limit) return;
+    const size_t most = size_t(limit / perPixel);
     // The largest image of this aspect with at most `most` pixels.
     const double scale = std::sqrt(double(most) / double(pixels));
     int w = std::max(1, int(width * scale)), h = std::max(1, int(height * scale));
     while (size_t(w) * h > most && w > 1 && h > 1) --(w >= h ? w : h);
-    throw InputError(strf("%s: %s at %dx%d needs %.1f MiB for its %s (%zu bytes a pixel), more than the device's "
-                          "largest storage buffer (%.1f MiB): at most %zu pixels on this device, e.g. %dx%d; %s",
-                          ctx.deviceName().c_str(), what.c_str(), width, height, double(pixels * bytes) / 1048576.0,
-                          name.c_str(), bytes, double(limit) / 1048576.0, most, w, h, remedy.c_str()));
+    throw InputError(strf("%s: %s at %dx%d needs %.1f %s for its %s (%zu %s a pixel), more than the device's largest "
+                          "%s (%.1f %s): at most %zu pixels on this device, e.g. %dx%d; %s",
+                          ctx.deviceName().c_str(), what.c_str(), width, height, double(pixels * perPixel) / unitScale,
+                          scaled, name.c_str(), perPixel, unit, kind, double(limit) / unitScale, scaled, most, w, h,
+                          remedy.c_str()));
+  };
+  for (const auto& [name, bytes] : buffers.storageBytes) {
+    check(name, bytes, ctx.limits().maxStorageBufferRange, "bytes", "storage buffer", 1048576.0, "MiB");
+  }
+  for (const auto& [name, texels] : buffers.texels) {
+    check(name, texels, ctx.limits().maxTexelBufferElements, "texels", "texel buffer", 1048576.0, "M texels");
   }
 }
 

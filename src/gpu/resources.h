@@ -58,7 +58,8 @@ class TexelBuffer {
   // `format`: VK_FORMAT_R32_SFLOAT, VK_FORMAT_R32_UINT (4 bytes per element),
   // VK_FORMAT_R32G32B32A32_SFLOAT or _UINT (16); `count` elements, uploaded from `data` where
   // not null.
-  TexelBuffer(Context& ctx, const void* data, size_t count, VkFormat format, const std::string& name);
+  TexelBuffer(Context& ctx, const void* data, size_t count, VkFormat format, const std::string& name,
+              bool storage = false);
   ~TexelBuffer();
   TexelBuffer(TexelBuffer&& o) noexcept { *this = std::move(o); }
   TexelBuffer& operator=(TexelBuffer&& o) noexcept;
@@ -101,14 +102,19 @@ class Image3D {
   size_t texelBytes_ = 0;
 };
 
-// The storage buffers an estimator allocates per pixel of a width x height image, (name, bytes per
-// pixel) each: every one must fit the device's largest storage buffer (maxStorageBufferRange;
-// lavapipe 128 MiB). Otherwise throws InputError naming `what`, the buffer that does not fit, the
-// most pixels that do, an image of the same aspect that fits, and `remedy` (what else the user can
-// change), before anything is compiled or allocated.
-void requirePerPixelStorage(const Context& ctx, const std::string& what,
-                            const std::vector<std::pair<std::string, size_t>>& bytesPerPixel, int width, int height,
-                            const std::string& remedy);
+// What an estimator allocates per pixel of its image: storage buffers (name, bytes per pixel),
+// each of which must fit the device's largest storage buffer (maxStorageBufferRange; lavapipe
+// 128 MiB), and storage texel buffers (name, texels per pixel), each within maxTexelBufferElements
+// (lavapipe 2^27).
+struct PerPixelBuffers {
+  std::vector<std::pair<std::string, size_t>> storageBytes;
+  std::vector<std::pair<std::string, size_t>> texels;
+};
+// Throws InputError where a width x height image does not fit, naming `what`, the buffer, the
+// most pixels that fit, an image of the same aspect that does, and `remedy` (what else the user
+// can change); call it before anything is compiled or allocated.
+void requirePerPixelStorage(const Context& ctx, const std::string& what, const PerPixelBuffers& buffers, int width,
+                            int height, const std::string& remedy);
 
 // A layout transition of a whole single-mip colour image.
 void imageBarrier(VkCommandBuffer cmd, VkImage image, VkImageLayout from, VkImageLayout to, VkAccessFlags srcAccess,

@@ -118,19 +118,20 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   const int emitting = std::min({scene.render.maxBounces + 1, prefix + 1, int(shared::RS_MAX_VERTICES)});
   const bool tail = scene.render.maxBounces > prefix || (endsInEmission && scene.render.maxBounces + 1 > emitting);
   const int vertices = endsInEmission ? emitting : prefix;  // stored per path
-  // Every per-pixel buffer below in one storage binding (session 25: at 1920x1080 lavapipe's
-  // 128 MiB held none of the three largest), checked before anything is compiled.
+  // Every per-pixel buffer below within the device's limits (session 25: at 1920x1080 lavapipe's
+  // 128 MiB storage buffers held none of the three largest), checked before anything is compiled.
+  // The stored paths' vertices, the largest and the one that grows with the bounces, are a storage
+  // texel buffer (lavapipe: 2^27 texels, 2 GiB).
   {
     const size_t stride = size_t(std::max(1, vertices - 1));
     const size_t slots = 2 + shared::RS_STATE_SLOTS + (features_.emitters ? shared::RS_LAMP_SLOTS : 0);
-    gpu::requirePerPixelStorage(
-        ctx, "ReSTIR", {{"reservoir path vertices", kSets * stride * sizeof(glm::vec4)},
-                        {"accumulation and pass state", slots * sizeof(glm::vec4)},
-                        {"reservoir paths", kSets * sizeof(shared::RsPathHead)},
-                        {"reservoirs", kSets * sizeof(shared::RsPacked)}},
-        scene.camera.width, scene.camera.height,
-        "fewer bounces keep fewer vertices a path (render.max_bounces, render.restir_prefix); --mode pt renders "
-        "large images in parts; or a device with larger limits (--device)");
+    gpu::PerPixelBuffers perPixel;
+    perPixel.storageBytes = {{"accumulation and pass state", slots * sizeof(glm::vec4)},
+                             {"reservoir paths", kSets * sizeof(shared::RsPathHead)},
+                             {"reservoirs", kSets * sizeof(shared::RsPacked)}};
+    perPixel.texels = {{"reservoir path vertices", kSets * stride}};
+    gpu::requirePerPixelStorage(ctx, "ReSTIR", perPixel, scene.camera.width, scene.camera.height,
+                                "--mode pt renders large images in parts; or a device with larger limits (--device)");
   }
   if (options_.neighbours > int(shared::RS_MAX_NEIGHBOURS)) {
     throw InputError(scene.path + strf(": render.restir_neighbours: at most %u", shared::RS_MAX_NEIGHBOURS));
@@ -154,7 +155,9 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
                                               : shared::RS_BINDING_COUNT;
   const gpu::BindingTypes types =
       sceneBindingTypes(true, features_.emission, features_.surfaces, shared::RS_SURF_BINDING_SHIFT);
-  const std::vector<BindingType> bindings = gpu::bindingTable(count, types);
+  gpu::BindingTypes withTexels = types;
+  withTexels.push_back({shared::BIND_RS_BOUNCES, BindingType::StorageTexelBuffer});
+  const std::vector<BindingType> bindings = gpu::bindingTable(count, withTexels);
   const gpu::ShaderDefines defines = features_.defines();
   const std::string variant = " [" + features_.name() + "]";
   // Each pass is compiled with only the code its options use (MIS kind, temporal or spatial,
@@ -219,7 +222,8 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
                              "restir parameters");
   reservoirs_ = gpu::Buffer(ctx, kSets * pixels * sizeof(shared::RsPacked), storage, "reservoirs");
   paths_ = gpu::Buffer(ctx, kSets * pixels * sizeof(shared::RsPathHead), storage, "reservoir paths");
-  bounces_ = gpu::Buffer(ctx, kSets * pixels * stride * sizeof(glm::vec4), storage, "reservoir path vertices");
+  bounces_ = gpu::TexelBuffer(ctx, nullptr, kSets * pixels * stride, VK_FORMAT_R32G32B32A32_SFLOAT,
+                              "reservoir path vertices", true);
   // The accumulation, then each pixel's state between the dispatches of a pass (the candidates'
   // running reservoir, the tail's walk: restir/bridge.glsl rs_state_slot), then with emissive
   // surfaces the lamp reservoirs (rs_lamp_slot).
