@@ -18,6 +18,8 @@ namespace plume::gpu {
 
 // StorageBuffer: read-write arrays. UniformBuffer: a small parameter block that every lane reads
 // at the same place (std140). TexelBuffer: a read-only array read per lane (gpu::TexelBuffer).
+// StorageTexelBuffer: a read-write array of texels (imageBuffer; gpu::TexelBuffer made with
+// `storage`), bounded by maxTexelBufferElements rather than maxStorageBufferRange.
 enum class BindingType { StorageBuffer, UniformBuffer, SampledImage, TexelBuffer, StorageTexelBuffer };
 
 // A pass's binding table: bindings 0 .. count-1 are storage buffers except those listed with
