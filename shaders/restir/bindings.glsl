@@ -26,19 +26,29 @@ layout(std430, binding = BIND_RS_PARAMS) readonly buffer RestirParamBuffer {
   uint rsPixels[];
 };
 RestirParams rsp;  // a private copy (volume/bindings.glsl says why), loaded by rs_load_params()
-// Reservoir sets: [set * pixels + pixel].
-layout(std430, binding = BIND_RS_RESERVOIRS) buffer ReservoirBuffer { RsPacked rsReservoirs[]; };
-// Path heads as stored: two uvec4 per RsPathHead (its C++ layout), loaded and stored whole by
-// rs_load_head / rs_store_head (restir/bridge.glsl): two vector accesses instead of one per field.
-layout(std430, binding = BIND_RS_PATHS) buffer PathBuffer { uvec4 rsPathWords[]; };
+// Every per-pixel array that grows with the image is a storage texel buffer, whose limit is
+// maxTexelBufferElements texels (lavapipe: 2^27, 2 GiB of 16-byte texels), not a storage buffer
+// (maxStorageBufferRange, lavapipe: 128 MiB: ReSTIR at 1920x1080 fitted none of its three largest,
+// session 25). Only the accumulation, which the viewer's display reads, is a storage buffer. The
+// integer formats keep every bit (the state holds counters as float bits).
+// Reservoir sets: texel [set * pixels + pixel] holds RsPacked's four words.
+layout(rgba32ui, binding = BIND_RS_RESERVOIRS) uniform uimageBuffer rsReservoirTexels;
+// Path heads as stored: two texels per RsPathHead (its C++ layout), texels 2 * (set * pixels +
+// pixel) and the next, loaded and stored whole by rs_load_head / rs_store_head (restir/bridge.glsl);
+// past the RS_SETS sets' heads, the passes' state between dispatches (bridge.glsl rs_state_slot).
+layout(rgba32ui, binding = BIND_RS_PATHS) uniform uimageBuffer rsPathTexels;
+uvec4 rs_path_word(uint i) { return imageLoad(rsPathTexels, int(i)); }
+void rs_set_path_word(uint i, uvec4 v) { imageStore(rsPathTexels, int(i), v); }
+// A vec4 of the passes' state (its bits as they were stored).
+vec4 rs_state(uint i) { return uintBitsToFloat(imageLoad(rsPathTexels, int(i))); }
+void rs_set_state(uint i, vec4 v) { imageStore(rsPathTexels, int(i), floatBitsToUint(v)); }
 // Vertices 2..n of each stored path: texel (set * pixels + pixel) * stride + i - 2 = (w_i, t_i).
 // A storage texel buffer: its limit is maxTexelBufferElements texels (lavapipe: 2^27, 2 GiB of
 // rgba32f), not maxStorageBufferRange (lavapipe: 128 MiB, 0.4 megapixels at 8 bounces).
 layout(rgba32f, binding = BIND_RS_BOUNCES) uniform imageBuffer rsBounceTexels;
 vec4 rs_bounce(uint i) { return imageLoad(rsBounceTexels, int(i)); }
 void rs_set_bounce(uint i, vec4 v) { imageStore(rsBounceTexels, int(i), v); }
-// Progressive accumulation of final shading: [2 * pixel] = (mean rgb, n), [2 * pixel + 1] = (M2 rgb, 0);
-// then RS_STATE_SLOTS per pixel of the passes' state between dispatches (bridge.glsl rs_state_slot).
+// Progressive accumulation of final shading: [2 * pixel] = (mean rgb, n), [2 * pixel + 1] = (M2 rgb, 0).
 layout(std430, binding = BIND_RS_OUTPUT) buffer OutputBuffer { vec4 rsOutput[]; };
 // rsCounters[0]: reservoirs whose non-finite weights were dropped on unpack (this frame).
 layout(std430, binding = BIND_RS_COUNTERS) buffer RestirCounterBuffer { uint rsCounters[]; };

@@ -245,19 +245,24 @@ float rs_resample_light(PathVertex vx, vec3 f, inout RngState rng, out uint ligh
 uint rs_slot(uint set, uint pixelIndex) { return set * rsp.pixelCount + pixelIndex; }
 uint rs_bounce_base(uint set, uint pixelIndex) { return rs_slot(set, pixelIndex) * rsp.bounceStride; }
 
+RsPacked rs_packed(uvec4 words) { return RsPacked(uintBitsToFloat(words.x), uintBitsToFloat(words.y), uintBitsToFloat(words.z), words.w); }
+
 RsReservoir rs_load(uint set, uint pixelIndex) {
   bool dropped;
-  RsReservoir r = rs_unpack(rsReservoirs[rs_slot(set, pixelIndex)], dropped);
+  RsReservoir r = rs_unpack(rs_packed(imageLoad(rsReservoirTexels, int(rs_slot(set, pixelIndex)))), dropped);
   if (dropped) atomicAdd(rsCounters[0], 1u);
   return r;
 }
 
-void rs_store(uint set, uint pixelIndex, RsReservoir r) { rsReservoirs[rs_slot(set, pixelIndex)] = rs_pack(r); }
+void rs_store(uint set, uint pixelIndex, RsReservoir r) {
+  RsPacked p = rs_pack(r);
+  imageStore(rsReservoirTexels, int(rs_slot(set, pixelIndex)), uvec4(floatBitsToUint(vec3(p.w_sum, p.p_hat, p.W)), p.M_fixed));
+}
 
 RsPathHead rs_load_head(uint set, uint pixelIndex) {
   uint i = 2u * rs_slot(set, pixelIndex);
-  uvec4 a = rsPathWords[i];
-  uvec4 b = rsPathWords[i + 1u];
+  uvec4 a = rs_path_word(i);
+  uvec4 b = rs_path_word(i + 1u);
   RsPathHead h;
   h.lightSample = uintBitsToFloat(a.xy);
   h.t1 = uintBitsToFloat(a.z);
@@ -271,27 +276,33 @@ RsPathHead rs_load_head(uint set, uint pixelIndex) {
 
 void rs_store_head(uint set, uint pixelIndex, RsPathHead h) {
   uint i = 2u * rs_slot(set, pixelIndex);
-  rsPathWords[i] = uvec4(floatBitsToUint(h.lightSample), floatBitsToUint(h.t1), h.vertexCount);
-  rsPathWords[i + 1u] = uvec4(h.light, h.kinds, h.uv, h.lightPrim);
+  rs_set_path_word(i, uvec4(floatBitsToUint(h.lightSample), floatBitsToUint(h.t1), h.vertexCount));
+  rs_set_path_word(i + 1u, uvec4(h.light, h.kinds, h.uv, h.lightPrim));
 }
 
-// A pixel's state between the dispatches of one pass (RS_STATE_SLOTS vec4s past the
-// accumulation): the candidates' running reservoir (restir/candidates.glsl), then final
+// A pixel's state between the dispatches of one pass (RS_STATE_SLOTS texels past the path heads,
+// rs_state / rs_set_state): the candidates' running reservoir (restir/candidates.glsl), then final
 // shading's tail (restir/shade.glsl).
-uint rs_state_slot(uint pixelIndex) { return 2u * rsp.pixelCount + RS_STATE_SLOTS * pixelIndex; }
+uint rs_state_slot(uint pixelIndex) { return 2u * RS_SETS * rsp.pixelCount + RS_STATE_SLOTS * pixelIndex; }
 // A pixel's lamp reservoir of set `set` (RestirParams::lampSet), past the state.
-uint rs_lamp_slot(uint set, uint pixelIndex) { return (2u + RS_STATE_SLOTS + set) * rsp.pixelCount + pixelIndex; }
+uint rs_lamp_slot(uint set, uint pixelIndex) {
+  return (2u * RS_SETS + RS_STATE_SLOTS + set) * rsp.pixelCount + pixelIndex;
+}
 
 // Vertex count of the stored path (0: none), and marking a slot empty.
-uint rs_path_length(uint set, uint pixelIndex) { return rsPathWords[2u * rs_slot(set, pixelIndex)].w; }
-void rs_clear_path(uint set, uint pixelIndex) { rsPathWords[2u * rs_slot(set, pixelIndex)].w = 0u; }
+uint rs_path_length(uint set, uint pixelIndex) { return rs_path_word(2u * rs_slot(set, pixelIndex)).w; }
+void rs_clear_path(uint set, uint pixelIndex) {
+  uint i = 2u * rs_slot(set, pixelIndex);
+  uvec4 a = rs_path_word(i);
+  rs_set_path_word(i, uvec4(a.xyz, 0u));
+}
 
 void rs_copy_path(uint srcSet, uint srcPixel, uint dstSet, uint dstPixel) {
   uint s = 2u * rs_slot(srcSet, srcPixel);
   uint d = 2u * rs_slot(dstSet, dstPixel);
-  uvec4 head = rsPathWords[s];
-  rsPathWords[d] = head;
-  rsPathWords[d + 1u] = rsPathWords[s + 1u];
+  uvec4 head = rs_path_word(s);
+  rs_set_path_word(d, head);
+  rs_set_path_word(d + 1u, rs_path_word(s + 1u));
   uint a = rs_bounce_base(srcSet, srcPixel);
   uint b = rs_bounce_base(dstSet, dstPixel);
   for (uint i = 1u; i < head.w; ++i) rs_set_bounce(b + i - 1u, rs_bounce(a + i - 1u));

@@ -94,7 +94,7 @@ void rs_lamp_reservoir(RsDomain D, uint pixelIndex, inout RngState rng) {
   r.M = 1.0f;
   rs_finalize(r);
   if (rsp.lampHistory != 0u) {
-    vec4 stored = rsOutput[rs_lamp_slot(1u - rsp.lampSet, pixelIndex)];
+    vec4 stored = rs_state(rs_lamp_slot(1u - rsp.lampSet, pixelIndex));
     RsReservoir h = rs_empty();
     h.W = rs_is_finite(stored.x) && stored.x > 0.0f ? stored.x : 0.0f;
     h.M = min(stored.y, rsp.historyCap);  // c x the canonical confidence 1
@@ -112,7 +112,7 @@ void rs_lamp_reservoir(RsDomain D, uint pixelIndex, inout RngState rng) {
     rs_finalize(o);
     r = o;
   }
-  rsOutput[rs_lamp_slot(rsp.lampSet, pixelIndex)] = vec4(r.W, r.M, uintBitsToFloat(uv), r.p_hat);
+  rs_set_state(rs_lamp_slot(rsp.lampSet, pixelIndex), vec4(r.W, r.M, uintBitsToFloat(uv), r.p_hat));
 }
 #endif
 
@@ -151,7 +151,7 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
     head.uv = 0u;
     head.lightPrim = 0u;
   } else {  // the walks before this one
-    vec4 state = rsOutput[rs_state_slot(pixelIndex)];
+    vec4 state = rs_state(rs_state_slot(pixelIndex));
     r.w_sum = state.x;
     r.p_hat = state.y;
     rng.counter = floatBitsToUint(state.z);
@@ -342,7 +342,7 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
     }
   }
   if (last < M) {
-    rsOutput[rs_state_slot(pixelIndex)] = vec4(r.w_sum, r.p_hat, uintBitsToFloat(rng.counter), 0.0f);
+    rs_set_state(rs_state_slot(pixelIndex), vec4(r.w_sum, r.p_hat, uintBitsToFloat(rng.counter), 0.0f));
     rs_store_head(outSet, pixelIndex, head);
     return;
   }

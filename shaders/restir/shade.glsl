@@ -44,22 +44,22 @@ struct RsTail {
   vec3 shaded;  // final shading's other terms (rs_shade): the pixel's sample is shaded + L
 };
 
-// The walk's state: rsOutput[rs_state_slot(pixel) + i], i < RS_STATE_SLOTS.
+// The walk's state: rs_state(rs_state_slot(pixel) + i), i < RS_STATE_SLOTS.
 RsTail rs_tail_load(uint pixelIndex) {
   uint s = rs_state_slot(pixelIndex);
-  vec4 a = rsOutput[s], b = rsOutput[s + 1u];
-  vec4 c = rsOutput[s + 2u];
-  return RsTail(a.xyz, floatBitsToUint(a.w), b.xyz, floatBitsToUint(b.w), c.xyz, c.w, rsOutput[s + 3u].xyz,
-                rsOutput[s + 4u].xyz);
+  vec4 a = rs_state(s), b = rs_state(s + 1u);
+  vec4 c = rs_state(s + 2u);
+  return RsTail(a.xyz, floatBitsToUint(a.w), b.xyz, floatBitsToUint(b.w), c.xyz, c.w, rs_state(s + 3u).xyz,
+                rs_state(s + 4u).xyz);
 }
 
 void rs_tail_store(uint pixelIndex, RsTail s) {
   uint i = rs_state_slot(pixelIndex);
-  rsOutput[i] = vec4(s.x, uintBitsToFloat(s.j));
-  rsOutput[i + 1u] = vec4(s.w, uintBitsToFloat(s.rngCounter));
-  rsOutput[i + 2u] = vec4(s.beta, s.pdfDir);
-  rsOutput[i + 3u] = vec4(s.L, 0.0f);
-  rsOutput[i + 4u] = vec4(s.shaded, 0.0f);
+  rs_set_state(i, vec4(s.x, uintBitsToFloat(s.j)));
+  rs_set_state(i + 1u, vec4(s.w, uintBitsToFloat(s.rngCounter)));
+  rs_set_state(i + 2u, vec4(s.beta, s.pdfDir));
+  rs_set_state(i + 3u, vec4(s.L, 0.0f));
+  rs_set_state(i + 4u, vec4(s.shaded, 0.0f));
 }
 
 RsTail rs_tail_start(RsDomain D, vec3 shaded, inout RngState rng) {
@@ -138,7 +138,7 @@ vec3 rs_shade(RsDomain D, uint pixelIndex, uint set, inout RngState rng) {
 #ifdef PLUME_HAS_EMITTERS
   // The lamps seen directly: their reservoir's sample (restir/candidates.glsl rs_lamp_reservoir),
   // W Le T along its ray, T by residual ratio tracking.
-  vec4 lamp = rsOutput[rs_lamp_slot(rsp.lampSet, pixelIndex)];
+  vec4 lamp = rs_state(rs_lamp_slot(rsp.lampSet, pixelIndex));
   if (lamp.x > 0.0f) {
     vec3 dirL = rs_domain_dir(D, rs_unpack_uv(floatBitsToUint(lamp.z)));
     BvhHit hitL = bvh_closest(D.origin, dirL, 0.0f, SURF_FAR);

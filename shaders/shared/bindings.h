@@ -40,9 +40,10 @@ const uint BIND_PREV_VOLUME = 9u;
 const uint BIND_PREV_ATLAS = 10u;
 const uint BIND_PREV_INDIRECTION = 11u;
 const uint BIND_PREV_MEAN_FIELD = 12u;
-const uint BIND_RS_RESERVOIRS = 13u;   // RsPacked[set * pixels + pixel]
-const uint BIND_RS_PATHS = 14u;        // RsPathHead[set * pixels + pixel]
-const uint BIND_RS_BOUNCES = 15u;      // vec4(w_i, t_i) of vertices 2..n (a storage texel buffer)
+// The reservoirs, the paths and the passes' state are storage texel buffers (restir/bindings.glsl).
+const uint BIND_RS_RESERVOIRS = 13u;   // RsPacked of [set * pixels + pixel], one uvec4 texel each
+const uint BIND_RS_PATHS = 14u;        // RsPathHead[set * pixels + pixel] in uvec4 texels, then the state
+const uint BIND_RS_BOUNCES = 15u;      // vec4(w_i, t_i) of vertices 2..n
 const uint BIND_RS_OUTPUT = 16u;       // accumulation of final shading (as BIND_PT_ACCUM)
 const uint BIND_RS_COUNTERS = 17u;     // uint[]: [0] reservoirs dropped for non-finite weights
 const uint BIND_LIGHT_CHOICE = 18u;    // GpuLightChoice[]

@@ -48,6 +48,8 @@ const uint RS_TAIL_SEGMENTS = 8u;
 // K vertices, or one; restir/candidates.glsl). (M 16 x K 16 = 256 had no cut in the dense bright
 // cloud, M 64 x K 16 in one dispatch had: notes/extreme.md.)
 const uint RS_CANDIDATE_VERTICES = 64u;
+// Reservoir sets per pixel: candidates / temporal / spatial rotate through them (Restir::render).
+const uint RS_SETS = 3u;
 // vec4s per pixel of a pass's state between its dispatches (restir/bridge.glsl rs_state_slot):
 // the candidates' running reservoir (1), the tail's walk (5, restir/shade.glsl RsTail).
 const uint RS_STATE_SLOTS = 5u;

@@ -65,6 +65,7 @@ class TexelBuffer {
   TexelBuffer& operator=(TexelBuffer&& o) noexcept;
 
   VkBufferView view() const { return view_; }
+  void fillZero() { buffer_.fillZero(); }
 
  private:
   void release();

@@ -91,7 +91,7 @@ std::vector<shared::GpuLightChoice> lightChoice(const Scene& scene, glm::vec3 ce
   return choice;
 }
 
-constexpr uint32_t kSets = 3;  // candidates / temporal / spatial rotate through three sets
+constexpr uint32_t kSets = shared::RS_SETS;
 
 }  // namespace
 
@@ -118,18 +118,18 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   const int emitting = std::min({scene.render.maxBounces + 1, prefix + 1, int(shared::RS_MAX_VERTICES)});
   const bool tail = scene.render.maxBounces > prefix || (endsInEmission && scene.render.maxBounces + 1 > emitting);
   const int vertices = endsInEmission ? emitting : prefix;  // stored per path
-  // Every per-pixel buffer below within the device's limits (session 25: at 1920x1080 lavapipe's
-  // 128 MiB storage buffers held none of the three largest), checked before anything is compiled.
-  // The stored paths' vertices, the largest and the one that grows with the bounces, are a storage
-  // texel buffer (lavapipe: 2^27 texels, 2 GiB).
+  // Every per-pixel buffer below within the device's limits, checked before anything is compiled.
+  // All but the accumulation (which the viewer's display reads) are storage texel buffers, whose
+  // limit on lavapipe is 2^27 texels (2 GiB) where a storage buffer's is 128 MiB: at 1920x1080 the
+  // storage buffers held none of the four largest (session 25).
+  const size_t stateTexels = shared::RS_STATE_SLOTS + (features_.emitters ? shared::RS_LAMP_SLOTS : 0);
   {
     const size_t stride = size_t(std::max(1, vertices - 1));
-    const size_t slots = 2 + shared::RS_STATE_SLOTS + (features_.emitters ? shared::RS_LAMP_SLOTS : 0);
     gpu::PerPixelBuffers perPixel;
-    perPixel.storageBytes = {{"accumulation and pass state", slots * sizeof(glm::vec4)},
-                             {"reservoir paths", kSets * sizeof(shared::RsPathHead)},
-                             {"reservoirs", kSets * sizeof(shared::RsPacked)}};
-    perPixel.texels = {{"reservoir path vertices", kSets * stride}};
+    perPixel.storageBytes = {{"accumulation", 2 * sizeof(glm::vec4)}, {"pixel order", sizeof(uint32_t)}};
+    perPixel.texels = {{"reservoir path vertices", kSets * stride},
+                       {"reservoir paths and pass state", kSets * 2 + stateTexels},
+                       {"reservoirs", kSets}};
     gpu::requirePerPixelStorage(ctx, "ReSTIR", perPixel, scene.camera.width, scene.camera.height,
                                 "--mode pt renders large images in parts; or a device with larger limits (--device)");
   }
@@ -156,7 +156,9 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   const gpu::BindingTypes types =
       sceneBindingTypes(true, features_.emission, features_.surfaces, shared::RS_SURF_BINDING_SHIFT);
   gpu::BindingTypes withTexels = types;
-  withTexels.push_back({shared::BIND_RS_BOUNCES, BindingType::StorageTexelBuffer});
+  for (uint32_t b : {shared::BIND_RS_RESERVOIRS, shared::BIND_RS_PATHS, shared::BIND_RS_BOUNCES}) {
+    withTexels.push_back({b, BindingType::StorageTexelBuffer});
+  }
   const std::vector<BindingType> bindings = gpu::bindingTable(count, withTexels);
   const gpu::ShaderDefines defines = features_.defines();
   const std::string variant = " [" + features_.name() + "]";
@@ -220,15 +222,16 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   // The parameters, then the frame's pixels in the passes' order (restir/bindings.glsl rsPixels).
   paramBuffer_ = gpu::Buffer(ctx, sizeof(shared::RestirParams) + pixels * sizeof(uint32_t), storage,
                              "restir parameters");
-  reservoirs_ = gpu::Buffer(ctx, kSets * pixels * sizeof(shared::RsPacked), storage, "reservoirs");
-  paths_ = gpu::Buffer(ctx, kSets * pixels * sizeof(shared::RsPathHead), storage, "reservoir paths");
-  bounces_ = gpu::TexelBuffer(ctx, nullptr, kSets * pixels * stride, VK_FORMAT_R32G32B32A32_SFLOAT,
-                              "reservoir path vertices", true);
-  // The accumulation, then each pixel's state between the dispatches of a pass (the candidates'
+  static_assert(sizeof(shared::RsPacked) == 16 && sizeof(shared::RsPathHead) == 32);  // 1 and 2 texels
+  reservoirs_ = gpu::TexelBuffer(ctx, nullptr, kSets * pixels, VK_FORMAT_R32G32B32A32_UINT, "reservoirs", true);
+  // The path heads, then each pixel's state between the dispatches of a pass (the candidates'
   // running reservoir, the tail's walk: restir/bridge.glsl rs_state_slot), then with emissive
   // surfaces the lamp reservoirs (rs_lamp_slot).
-  const size_t slots = 2 + shared::RS_STATE_SLOTS + (features_.emitters ? shared::RS_LAMP_SLOTS : 0);
-  output_ = gpu::Buffer(ctx, slots * pixels * sizeof(glm::vec4), storage, "restir accumulation");
+  paths_ = gpu::TexelBuffer(ctx, nullptr, (kSets * 2 + stateTexels) * pixels, VK_FORMAT_R32G32B32A32_UINT,
+                            "reservoir paths and pass state", true);
+  bounces_ = gpu::TexelBuffer(ctx, nullptr, kSets * pixels * stride, VK_FORMAT_R32G32B32A32_SFLOAT,
+                              "reservoir path vertices", true);
+  output_ = gpu::Buffer(ctx, 2 * pixels * sizeof(glm::vec4), storage, "restir accumulation");
   counters_ = gpu::Buffer(ctx, shared::RS_COUNTERS * sizeof(uint32_t), storage, "restir counters");
   counters_.fillZero();
   reservoirs_.fillZero();

@@ -121,8 +121,10 @@ class Restir {
   uint32_t tailDispatches_ = 0;             // its dispatches per frame at most (max_bounces' walk)
   gpu::GpuTimer timer_;
   gpu::TexelBuffer lightBuffer_;
-  gpu::Buffer frameBuffer_, lightChoice_, paramBuffer_, reservoirs_, paths_, output_, counters_;
-  gpu::TexelBuffer bounces_;  // the stored paths' vertices 2..n (restir/bindings.glsl)
+  gpu::Buffer frameBuffer_, lightChoice_, paramBuffer_, output_, counters_;
+  // The reservoirs, the path heads with the passes' state, the paths' vertices 2..n
+  // (restir/bindings.glsl)
+  gpu::TexelBuffer reservoirs_, paths_, bounces_;
   shared::GpuFrame frame_{};
   shared::RestirParams params_{};
   uint32_t history_ = 0;
