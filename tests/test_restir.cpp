@@ -26,6 +26,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <random>
 #include <stdexcept>
 
@@ -441,6 +442,63 @@ TEST_F(GpuRestir, PixelsThatMissTheVolumeSkipTheWalksAndKeepTheImage) {
   }
 }
 
+// The stored paths' vertices in a storage buffer (PLUME_RS_VERTEX_BUFFER: where a device's texel
+// buffers cannot hold them and its storage buffers can, render/restir.cpp) give the frames of the
+// texel buffer, bit for bit: a moving camera over an animated grid with final shading's tail past
+// a prefix of two vertices, a still camera at 6 bounces, and walls with a fin (surfaces: the
+// reconnection vertex keeps a triangle index in a float's bits).
+TEST_F(GpuRestir, PathVerticesInAStorageBufferGiveTheSameFrames) {
+  Scene volumeOnly = baseScene(24);
+  volumeOnly.camera.base.position = {1.0f, 1.2f, 7.5f};
+  const Scene moving = movedBy(volumeOnly, 4, {2.4f, 1.6f, 7.0f});
+  const Scene walls = test::wallsAndFinScene(24, 3);
+  struct Case {
+    const char* name;
+    const Scene* scene;
+    bool animated;
+    int maxBounces;
+    int prefix;
+  };
+  const Case cases[] = {{"moving camera, animated grid, tail", &moving, true, 4, 2},
+                        {"still camera, 6 bounces", &volumeOnly, false, 6, 16},
+                        {"walls and fin, reconnection", &walls, false, 3, 16}};
+  for (const Case& c : cases) {
+    Scene s = *c.scene;
+    s.render.maxBounces = c.maxBounces;
+    std::vector<std::unique_ptr<GpuVolumeResources>> volumes;
+    for (int f = 1; f <= (c.animated ? 4 : 1); ++f) {
+      volumes.push_back(std::make_unique<GpuVolumeResources>(
+          ctx(), *bakeOf(test::makeNoiseGrid(c.scene == &walls ? 32 : 40, 1.0 / 20, unsigned(10 + f))),
+          s.media[0].densityScale));
+    }
+    auto frames = [&](bool inBuffer) {
+      RestirOptions o;
+      o.radius = 6;
+      o.prefix = c.prefix;
+      o.verticesInStorageBuffer = inBuffer;
+      Restir restir(ctx(), compiler(), s, o);
+      std::vector<Image> out;
+      for (int f = 1; f <= 4; ++f) {
+        const size_t cur = c.animated ? size_t(f - 1) : 0, prev = c.animated ? size_t(std::max(f - 2, 0)) : 0;
+        restir.setVolumes(*volumes[cur], *volumes[prev]);
+        out.push_back(restir.renderFrame(f, 1));
+      }
+      return out;
+    };
+    const std::vector<Image> texels = frames(false), buffer = frames(true);
+    size_t differ = 0, lit = 0;
+    for (size_t f = 0; f < texels.size(); ++f) {
+      for (size_t i = 0; i < texels[f].rgb.size(); ++i) {
+        differ += std::memcmp(&texels[f].rgb[i], &buffer[f].rgb[i], sizeof(float)) != 0 ? 1 : 0;
+        lit += texels[f].rgb[i] > 0.0f ? 1 : 0;
+      }
+    }
+    std::printf("[restir] vertices in a storage buffer, %s: %zu of %zu lit channels differ\n", c.name, differ, lit);
+    EXPECT_EQ(differ, 0u) << c.name << ": the vertices' storage must not change any pixel";
+    EXPECT_GT(lit, texels.size() * texels[0].rgb.size() / 2) << c.name << ": too few lit channels";
+  }
+}
+
 // restir_candidates_moving sets M only in frames whose camera moved since the previous frame:
 // with a still camera the scene's M applies (the same image to the bit as without the setting),
 // with a moving one the images differ. Unbiasedness with it is the Z-test below.
@@ -631,20 +689,37 @@ TEST_F(GpuRestir, AcceptsAnyMaxBouncesWithFixedMemory) {
 }
 
 // An image whose per-pixel buffers exceed the device's limits is bad input: an InputError before
-// anything is compiled or allocated, naming the buffer, the most pixels that fit and an image of
-// the same aspect that does (gpu::requirePerPixelStorage). ReSTIR's largest storage buffer is the
-// accumulation with the passes' state, 7 x 16 bytes a pixel (lavapipe's 128 MiB: 1.2 megapixels;
-// its path vertices, which grow with the bounces, are a texel buffer since session 25: 1280x720 at
-// 16 bounces renders there, where at most 0.19 megapixels did). The size is made from this
-// device's limit, so the test is the same on any device; the suggested image is checked against
-// the limit it was made from. The texel buffers' check, which ReSTIR's defaults do not reach
-// first, is called directly.
+// anything is compiled or allocated, naming the buffer that allows the fewest pixels, that number
+// and an image of the same aspect that fits every buffer (gpu::requirePerPixelStorage). ReSTIR's
+// per-pixel arrays at 16 bounces: the accumulation (32 bytes, a storage buffer, which the viewer's
+// display reads) and the pixel order (4 bytes); in storage texel buffers the paths' vertices (3 sets
+// x 15 texels; in a storage buffer instead where only that holds them), the path heads with the
+// passes' state (3 x 2 + 5 texels) and the reservoirs (3 texels). On lavapipe (128 MiB, 2^27
+// texels) the vertices decide: 2.98 megapixels (1920x1080 renders; session 25: the accumulation
+// with the state, 1.2 megapixels; session 24: 0.19). The size is made from this device's limits,
+// so the test is the same on any device; the suggested image is checked against the limit it was
+// made from. The texel buffers' check alone is called directly below.
 TEST_F(GpuRestir, ImageTooLargeForTheDeviceIsAClearErrorBeforeCompiling) {
   Scene s = baseScene(8);
   s.render.maxBounces = 16;
   RestirOptions o;
-  const double limit = double(ctx().limits().maxStorageBufferRange);
-  const double pixels = 1.5 * limit / 112.0;
+  const double bytes = double(ctx().limits().maxStorageBufferRange);
+  const double texelCount = double(ctx().limits().maxTexelBufferElements);
+  struct Array {
+    const char* name;
+    double most;  // pixels
+  };
+  const bool verticesInTexels = texelCount * 16.0 >= bytes;  // the larger kind holds them
+  const Array arrays[] = {{"accumulation (32 bytes a pixel)", bytes / 32.0},
+                          {"pixel order (4 bytes a pixel)", bytes / 4.0},
+                          {verticesInTexels ? "reservoir path vertices (45 texels a pixel)"
+                                            : "reservoir path vertices (720 bytes a pixel)",
+                           verticesInTexels ? texelCount / 45.0 : bytes / 720.0},
+                          {"reservoir paths and pass state (11 texels a pixel)", texelCount / 11.0},
+                          {"reservoirs (3 texels a pixel)", texelCount / 3.0}};
+  const Array* fewest = &arrays[0];
+  for (const Array& a : arrays) fewest = a.most < fewest->most ? &a : fewest;
+  const double pixels = 1.5 * fewest->most;
   s.camera.width = int(std::ceil(std::sqrt(pixels * 16.0 / 9.0)));
   s.camera.height = int(std::ceil(std::sqrt(pixels * 9.0 / 16.0)));
   try {
@@ -652,13 +727,13 @@ TEST_F(GpuRestir, ImageTooLargeForTheDeviceIsAClearErrorBeforeCompiling) {
     FAIL() << "a " << s.camera.width << "x" << s.camera.height << " image was accepted";
   } catch (const InputError& e) {
     const std::string m = e.what();
-    EXPECT_NE(m.find("accumulation and pass state (112 bytes a pixel)"), std::string::npos) << m;
+    EXPECT_NE(m.find(std::string("for its ") + fewest->name), std::string::npos) << m;
     const size_t at = m.find("e.g. ");
     ASSERT_NE(at, std::string::npos) << m;
     int w = 0, h = 0;
     ASSERT_EQ(std::sscanf(m.c_str() + at, "e.g. %dx%d", &w, &h), 2) << m;
-    EXPECT_LE(double(w) * h * 112.0, limit) << m;
-    EXPECT_GT(double(w) * h * 112.0, 0.98 * limit) << m;
+    EXPECT_LE(double(w) * h, fewest->most) << m;
+    EXPECT_GT(double(w) * h, 0.98 * fewest->most) << m;
     EXPECT_NEAR(double(w) / h, 16.0 / 9.0, 0.01) << m;
   }
   gpu::PerPixelBuffers texels;
@@ -672,5 +747,23 @@ TEST_F(GpuRestir, ImageTooLargeForTheDeviceIsAClearErrorBeforeCompiling) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("test texels (1024 texels a pixel), more than the device's largest texel buffer"),
               std::string::npos) << e.what();
+  }
+  // Two arrays, the one that allows fewer pixels named, the image suggested within both.
+  gpu::PerPixelBuffers two = texels;
+  const double storageLimit = double(ctx().limits().maxStorageBufferRange);
+  const size_t bytesPerPixel = size_t(std::ceil(storageLimit / (texelLimit / 1024.0) * 2.0));  // half the pixels
+  two.storageBytes = {{"test bytes", bytesPerPixel}};
+  try {
+    gpu::requirePerPixelStorage(ctx(), "test", two, side, side, "-");
+    FAIL() << side << "x" << side << " was accepted";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("test bytes ("), std::string::npos) << m;
+    const size_t at = m.find("e.g. ");
+    ASSERT_NE(at, std::string::npos) << m;
+    int w = 0, h = 0;
+    ASSERT_EQ(std::sscanf(m.c_str() + at, "e.g. %dx%d", &w, &h), 2) << m;
+    EXPECT_LE(double(w) * h * 1024.0, texelLimit) << m;
+    EXPECT_LE(double(w) * h * double(bytesPerPixel), storageLimit) << m;
   }
 }

@@ -28,7 +28,7 @@ layout(std430, binding = BIND_RS_PARAMS) readonly buffer RestirParamBuffer {
 RestirParams rsp;  // a private copy (volume/bindings.glsl says why), loaded by rs_load_params()
 // Every per-pixel array that grows with the image is a storage texel buffer, whose limit is
 // maxTexelBufferElements texels (lavapipe: 2^27, 2 GiB of 16-byte texels), not a storage buffer
-// (maxStorageBufferRange, lavapipe: 128 MiB: ReSTIR at 1920x1080 fitted none of its three largest,
+// (maxStorageBufferRange, lavapipe: 128 MiB: ReSTIR at 1920x1080 fitted none of its four largest,
 // session 25). Only the accumulation, which the viewer's display reads, is a storage buffer. The
 // integer formats keep every bit (the state holds counters as float bits).
 // Reservoir sets: texel [set * pixels + pixel] holds RsPacked's four words.
@@ -42,12 +42,18 @@ void rs_set_path_word(uint i, uvec4 v) { imageStore(rsPathTexels, int(i), v); }
 // A vec4 of the passes' state (its bits as they were stored).
 vec4 rs_state(uint i) { return uintBitsToFloat(imageLoad(rsPathTexels, int(i))); }
 void rs_set_state(uint i, vec4 v) { imageStore(rsPathTexels, int(i), floatBitsToUint(v)); }
-// Vertices 2..n of each stored path: texel (set * pixels + pixel) * stride + i - 2 = (w_i, t_i).
-// A storage texel buffer: its limit is maxTexelBufferElements texels (lavapipe: 2^27, 2 GiB of
-// rgba32f), not maxStorageBufferRange (lavapipe: 128 MiB, 0.4 megapixels at 8 bounces).
-layout(rgba32f, binding = BIND_RS_BOUNCES) uniform imageBuffer rsBounceTexels;
-vec4 rs_bounce(uint i) { return imageLoad(rsBounceTexels, int(i)); }
-void rs_set_bounce(uint i, vec4 v) { imageStore(rsBounceTexels, int(i), v); }
+// Vertices 2..n of each stored path: element (set * pixels + pixel) * stride + i - 2 = (w_i, t_i), its
+// bits as stored (the reconnection vertex keeps a triangle index in a float: restir_types.h). A
+// storage texel buffer, or where only a storage buffer holds them, one (render/restir.cpp).
+#ifdef PLUME_RS_VERTEX_BUFFER
+layout(std430, binding = BIND_RS_BOUNCES) buffer BounceBuffer { uvec4 rsBounceWords[]; };
+vec4 rs_bounce(uint i) { return uintBitsToFloat(rsBounceWords[i]); }
+void rs_set_bounce(uint i, vec4 v) { rsBounceWords[i] = floatBitsToUint(v); }
+#else
+layout(rgba32ui, binding = BIND_RS_BOUNCES) uniform uimageBuffer rsBounceTexels;
+vec4 rs_bounce(uint i) { return uintBitsToFloat(imageLoad(rsBounceTexels, int(i))); }
+void rs_set_bounce(uint i, vec4 v) { imageStore(rsBounceTexels, int(i), floatBitsToUint(v)); }
+#endif
 // Progressive accumulation of final shading: [2 * pixel] = (mean rgb, n), [2 * pixel + 1] = (M2 rgb, 0).
 layout(std430, binding = BIND_RS_OUTPUT) buffer OutputBuffer { vec4 rsOutput[]; };
 // rsCounters[0]: reservoirs whose non-finite weights were dropped on unpack (this frame).

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <cstdint>
 #include <cstring>
 #include <utility>
 
@@ -253,26 +254,36 @@ void Image3D::upload(const void* data, size_t bytes) {
 void requirePerPixelStorage(const Context& ctx, const std::string& what, const PerPixelBuffers& buffers, int width,
                             int height, const std::string& remedy) {
   const size_t pixels = size_t(width) * size_t(height);
-  auto check = [&](const std::string& name, size_t perPixel, uint64_t limit, const char* unit, const char* kind,
-                   double unitScale, const char* scaled) {
-    if (perPixel == 0 || uint64_t(pixels) * perPixel <= limit) return;
+  // The buffer that allows the fewest pixels decides: the image suggested fits every buffer.
+  struct Limiting {
+    std::string name;
+    size_t perPixel = 0, most = SIZE_MAX;
+    uint64_t limit = 0;
+    const char *unit = "", *kind = "", *scaled = "";
+  } worst;
+  auto consider = [&](const std::string& name, size_t perPixel, uint64_t limit, const char* unit, const char* kind,
+                      const char* scaled) {
+    if (perPixel == 0) return;
     const size_t most = size_t(limit / perPixel);
-    // The largest image of this aspect with at most `most` pixels.
-    const double scale = std::sqrt(double(most) / double(pixels));
-    int w = std::max(1, int(width * scale)), h = std::max(1, int(height * scale));
-    while (size_t(w) * h > most && w > 1 && h > 1) --(w >= h ? w : h);
-    throw InputError(strf("%s: %s at %dx%d needs %.1f %s for its %s (%zu %s a pixel), more than the device's largest "
-                          "%s (%.1f %s): at most %zu pixels on this device, e.g. %dx%d; %s",
-                          ctx.deviceName().c_str(), what.c_str(), width, height, double(pixels * perPixel) / unitScale,
-                          scaled, name.c_str(), perPixel, unit, kind, double(limit) / unitScale, scaled, most, w, h,
-                          remedy.c_str()));
+    if (most < worst.most) worst = {name, perPixel, most, limit, unit, kind, scaled};
   };
   for (const auto& [name, bytes] : buffers.storageBytes) {
-    check(name, bytes, ctx.limits().maxStorageBufferRange, "bytes", "storage buffer", 1048576.0, "MiB");
+    consider(name, bytes, ctx.limits().maxStorageBufferRange, "bytes", "storage buffer", "MiB");
   }
   for (const auto& [name, texels] : buffers.texels) {
-    check(name, texels, ctx.limits().maxTexelBufferElements, "texels", "texel buffer", 1048576.0, "M texels");
+    consider(name, texels, ctx.limits().maxTexelBufferElements, "texels", "texel buffer", "M texels");
   }
+  if (pixels <= worst.most) return;
+  // The largest image of this aspect with at most `most` pixels.
+  const double scale = std::sqrt(double(worst.most) / double(pixels));
+  int w = std::max(1, int(width * scale)), h = std::max(1, int(height * scale));
+  while (size_t(w) * h > worst.most && w > 1 && h > 1) --(w >= h ? w : h);
+  throw InputError(strf("%s: %s at %dx%d needs %.1f %s for its %s (%zu %s a pixel), more than the device's largest "
+                        "%s (%.1f %s): at most %zu pixels on this device, e.g. %dx%d; %s",
+                        ctx.deviceName().c_str(), what.c_str(), width, height,
+                        double(pixels * worst.perPixel) / 1048576.0, worst.scaled, worst.name.c_str(), worst.perPixel,
+                        worst.unit, worst.kind, double(worst.limit) / 1048576.0, worst.scaled, worst.most, w, h,
+                        remedy.c_str()));
 }
 
 void imageBarrier(VkCommandBuffer cmd, VkImage image, VkImageLayout from, VkImageLayout to, VkAccessFlags srcAccess,

@@ -111,9 +111,9 @@ struct PerPixelBuffers {
   std::vector<std::pair<std::string, size_t>> storageBytes;
   std::vector<std::pair<std::string, size_t>> texels;
 };
-// Throws InputError where a width x height image does not fit, naming `what`, the buffer, the
-// most pixels that fit, an image of the same aspect that does, and `remedy` (what else the user
-// can change); call it before anything is compiled or allocated.
+// Throws InputError where a width x height image does not fit, naming `what`, the buffer that
+// allows the fewest pixels, that number, an image of the same aspect that fits every buffer, and
+// `remedy` (what else the user can change); call it before anything is compiled or allocated.
 void requirePerPixelStorage(const Context& ctx, const std::string& what, const PerPixelBuffers& buffers, int width,
                             int height, const std::string& remedy);
 

@@ -122,14 +122,27 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   // All but the accumulation (which the viewer's display reads) are storage texel buffers, whose
   // limit on lavapipe is 2^27 texels (2 GiB) where a storage buffer's is 128 MiB: at 1920x1080 the
   // storage buffers held none of the four largest (session 25).
+  // The vertices, the one array that grows with the bounces, go in a storage buffer instead where
+  // the texel buffers cannot hold them and a storage buffer can (desktop GPU drivers publish 2^27
+  // texels, as lavapipe, and 2-4 GiB storage buffers: 3840x2160 at 8 bounces needs 174 M texels).
   const size_t stateTexels = shared::RS_STATE_SLOTS + (features_.emitters ? shared::RS_LAMP_SLOTS : 0);
+  const size_t pixelCount = size_t(scene.camera.width) * size_t(scene.camera.height);
+  const size_t vertexTexels = kSets * size_t(std::max(1, vertices - 1));  // per pixel
   {
-    const size_t stride = size_t(std::max(1, vertices - 1));
+    const VkPhysicalDeviceLimits& lim = ctx.limits();
+    const bool texelsFit = pixelCount * vertexTexels <= lim.maxTexelBufferElements;
+    const bool bufferFits = pixelCount * vertexTexels * sizeof(glm::vec4) <= lim.maxStorageBufferRange;
+    // Where neither holds them, the larger kind names the limit in the message below.
+    const bool bufferLarger = uint64_t(lim.maxStorageBufferRange) > uint64_t(lim.maxTexelBufferElements) * sizeof(glm::vec4);
+    verticesInBuffer_ = options_.verticesInStorageBuffer || (!texelsFit && (bufferFits || bufferLarger));
     gpu::PerPixelBuffers perPixel;
     perPixel.storageBytes = {{"accumulation", 2 * sizeof(glm::vec4)}, {"pixel order", sizeof(uint32_t)}};
-    perPixel.texels = {{"reservoir path vertices", kSets * stride},
-                       {"reservoir paths and pass state", kSets * 2 + stateTexels},
-                       {"reservoirs", kSets}};
+    perPixel.texels = {{"reservoir paths and pass state", kSets * 2 + stateTexels}, {"reservoirs", kSets}};
+    if (verticesInBuffer_) {
+      perPixel.storageBytes.push_back({"reservoir path vertices", vertexTexels * sizeof(glm::vec4)});
+    } else {
+      perPixel.texels.push_back({"reservoir path vertices", vertexTexels});
+    }
     gpu::requirePerPixelStorage(ctx, "ReSTIR", perPixel, scene.camera.width, scene.camera.height,
                                 "--mode pt renders large images in parts; or a device with larger limits (--device)");
   }
@@ -156,9 +169,9 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   const gpu::BindingTypes types =
       sceneBindingTypes(true, features_.emission, features_.surfaces, shared::RS_SURF_BINDING_SHIFT);
   gpu::BindingTypes withTexels = types;
-  for (uint32_t b : {shared::BIND_RS_RESERVOIRS, shared::BIND_RS_PATHS, shared::BIND_RS_BOUNCES}) {
-    withTexels.push_back({b, BindingType::StorageTexelBuffer});
-  }
+  withTexels.push_back({shared::BIND_RS_RESERVOIRS, BindingType::StorageTexelBuffer});
+  withTexels.push_back({shared::BIND_RS_PATHS, BindingType::StorageTexelBuffer});
+  if (!verticesInBuffer_) withTexels.push_back({shared::BIND_RS_BOUNCES, BindingType::StorageTexelBuffer});
   const std::vector<BindingType> bindings = gpu::bindingTable(count, withTexels);
   const gpu::ShaderDefines defines = features_.defines();
   const std::string variant = " [" + features_.name() + "]";
@@ -176,6 +189,7 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
     d.emplace_back("PLUME_RS_LIGHT_CANDIDATES", std::to_string(lightCandidates));
     // The reconnection shift only where there are surface vertices to reconnect to.
     if (features_.surfaces && options_.reconnect) d.emplace_back("PLUME_RS_RECONNECT", "1");
+    if (verticesInBuffer_) d.emplace_back("PLUME_RS_VERTEX_BUFFER", "1");
     d.insert(d.end(), extra.begin(), extra.end());
     return std::make_unique<gpu::ComputePass>(ctx, compiler.compile(file, d), bindings,
                                               uint32_t(sizeof(shared::RsPush)), name + variant, glm::uvec3(64, 1, 1));
@@ -229,8 +243,12 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   // surfaces the lamp reservoirs (rs_lamp_slot).
   paths_ = gpu::TexelBuffer(ctx, nullptr, (kSets * 2 + stateTexels) * pixels, VK_FORMAT_R32G32B32A32_UINT,
                             "reservoir paths and pass state", true);
-  bounces_ = gpu::TexelBuffer(ctx, nullptr, kSets * pixels * stride, VK_FORMAT_R32G32B32A32_SFLOAT,
-                              "reservoir path vertices", true);
+  if (verticesInBuffer_) {
+    bounceBuffer_ = gpu::Buffer(ctx, kSets * pixels * stride * sizeof(glm::vec4), storage, "reservoir path vertices");
+  } else {
+    bounces_ = gpu::TexelBuffer(ctx, nullptr, kSets * pixels * stride, VK_FORMAT_R32G32B32A32_UINT,
+                                "reservoir path vertices", true);
+  }
   output_ = gpu::Buffer(ctx, 2 * pixels * sizeof(glm::vec4), storage, "restir accumulation");
   counters_ = gpu::Buffer(ctx, shared::RS_COUNTERS * sizeof(uint32_t), storage, "restir counters");
   counters_.fillZero();
@@ -245,7 +263,11 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
     p->set.bind(shared::BIND_RS_PARAMS, paramBuffer_);
     p->set.bind(shared::BIND_RS_RESERVOIRS, reservoirs_);
     p->set.bind(shared::BIND_RS_PATHS, paths_);
-    p->set.bind(shared::BIND_RS_BOUNCES, bounces_);
+    if (verticesInBuffer_) {
+      p->set.bind(shared::BIND_RS_BOUNCES, bounceBuffer_);
+    } else {
+      p->set.bind(shared::BIND_RS_BOUNCES, bounces_);
+    }
     p->set.bind(shared::BIND_RS_OUTPUT, output_);
     p->set.bind(shared::BIND_RS_COUNTERS, counters_);
   }

@@ -58,6 +58,10 @@ struct RestirOptions {
   // camera rays may meet the volume only (render/pixel_order.h) and walk-free variants of the
   // passes over the others (PLUME_RS_OUTSIDE); the two must give one image, bit for bit.
   bool cullOutside = true;
+  // Tests only: true keeps the stored paths' vertices in a storage buffer (PLUME_RS_VERTEX_BUFFER)
+  // as on a device whose texel buffers cannot hold them but whose storage buffers can (otherwise
+  // the device's limits choose: Restir::Restir); the two must give one image, bit for bit.
+  bool verticesInStorageBuffer = false;
   std::string name() const;  // e.g. "restir pairwise M4 k3 r16 R1 c20" (r: radius in px)
 };
 // From the scene's render settings (render.restir_mis; mode restir-biased's RS_MIS_BIASED is set
@@ -119,12 +123,14 @@ class Restir {
   std::unique_ptr<gpu::ComputePass> candidatesOut_, temporalOut_, spatialOut_, shadeOut_;
   std::unique_ptr<gpu::ComputePass> tail_;  // final shading's tail (null without one)
   uint32_t tailDispatches_ = 0;             // its dispatches per frame at most (max_bounces' walk)
+  bool verticesInBuffer_ = false;           // the stored paths' vertices in a storage buffer (PLUME_RS_VERTEX_BUFFER)
   gpu::GpuTimer timer_;
   gpu::TexelBuffer lightBuffer_;
   gpu::Buffer frameBuffer_, lightChoice_, paramBuffer_, output_, counters_;
   // The reservoirs, the path heads with the passes' state, the paths' vertices 2..n
   // (restir/bindings.glsl)
   gpu::TexelBuffer reservoirs_, paths_, bounces_;
+  gpu::Buffer bounceBuffer_;  // the vertices where a storage buffer holds them and texels cannot
   shared::GpuFrame frame_{};
   shared::RestirParams params_{};
   uint32_t history_ = 0;
