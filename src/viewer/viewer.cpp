@@ -90,6 +90,12 @@ class Viewer {
   glm::dvec2 lastCursor_{0.0};
   int screenshots_ = 0;
   PassTimes rendererTimes_;
+  // Host time of each phase of a frame, summed over a scripted run's second half (logged at its end).
+  struct HostPhases {
+    double input = 0, acquire = 0, renderer = 0, record = 0, present = 0;
+    int frames = 0;
+  } host_;
+  bool timeHost_ = false;  // this frame's phases count
 };
 
 Viewer::Viewer(const ViewerOptions& o) : o_(o) {
@@ -240,8 +246,17 @@ void Viewer::applyRequests(const UiRequests& req) {
 }
 
 void Viewer::renderAndPresent(bool capture) {
+  using Clock = std::chrono::steady_clock;
+  auto since = [](Clock::time_point& t) {
+    const Clock::time_point now = Clock::now();
+    const double ms = std::chrono::duration<double, std::milli>(now - t).count();
+    t = now;
+    return ms;
+  };
+  Clock::time_point t = Clock::now();
   std::optional<uint32_t> index = swapchain_->acquire(window_->framebufferSize());
   if (!index) return;
+  const double acquireMs = since(t);
   if (displayTimed_) {
     PassTimes t = displayTimer_->read();
     stats_.passes = rendererTimes_;
@@ -264,6 +279,7 @@ void Viewer::renderAndPresent(bool capture) {
     haveImage_ = true;
   }
   stats_.samples = renderer_->samplesSoFar();
+  const double rendererMs = since(t);
   VkCommandBuffer cmd = swapchain_->commandBuffer();
   const VkExtent2D extent = swapchain_->extent();
   displayTimer_->reset(cmd);
@@ -277,7 +293,15 @@ void Viewer::renderAndPresent(bool capture) {
   ui_->record(cmd);
   vkCmdEndRenderPass(cmd);
   if (capture) readback_->record(cmd, swapchain_->image(*index), extent);
+  const double recordMs = since(t);
   swapchain_->submitAndPresent(*index, window_->framebufferSize());
+  if (timeHost_) {
+    host_.acquire += acquireMs;
+    host_.renderer += rendererMs;
+    host_.record += recordMs;
+    host_.present += since(t);
+    ++host_.frames;
+  }
 }
 
 int Viewer::run() {
@@ -296,6 +320,8 @@ int Viewer::run() {
     ui_->newFrame();
     if (s_.showUi) applyRequests(drawUi(s_, stats_));
     ui_->endFrame();
+    timeHost_ = scripted && n >= o_.scriptedFrames / 2;
+    if (timeHost_) host_.input += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - last).count();
     renderAndPresent(scripted && n == o_.scriptedFrames - 1 && !o_.captureWindow.empty());
     const auto now = std::chrono::steady_clock::now();
     const double ms = std::chrono::duration<double, std::milli>(now - last).count();
@@ -313,6 +339,12 @@ int Viewer::run() {
     const PassTimes display = displayTimer_->read();
     passes.insert(passes.end(), display.begin(), display.end());
     logInfo("view: last frame's passes: " + passTimesText(passes));
+    if (host_.frames > 0) {
+      const double k = 1.0 / host_.frames;
+      logInfo(strf("view: host ms a frame (the last %d frames): events and panel %.2f, acquire %.2f, renderer %.2f, "
+                   "recording %.2f, submit and present %.2f", host_.frames, host_.input * k, host_.acquire * k,
+                   host_.renderer * k, host_.record * k, host_.present * k));
+    }
     if (!o_.screenshot.empty()) {
       saveScreenshot(o_.screenshot, renderer_->readImage(), renderer_->samplesSoFar(), s_, ctx_->deviceName(),
                      s_.scene.camera.poseAt(s_.frame));
