@@ -4,6 +4,7 @@
 #include "core/error.h"
 #include "gpu/pipeline.h"
 #include "media/vdb_loader.h"
+#include "render/filter_probe.h"
 #include "render/gpu_volume.h"
 #include "shaders/shared/phase.h"
 #include "shaders/shared/rng.h"
@@ -149,6 +150,60 @@ TEST_F(GpuShared, HardwareFilteredDensityIsWithinTheDeviceWeightPrecision) {
   EXPECT_EQ(outside, 0) << "worst difference " << worst << " (subTexelPrecisionBits "
                         << ctx().limits().subTexelPrecisionBits << ")";
   EXPECT_GT(nonZero, n / 4) << "the cases must mostly fall where the grid has density";
+}
+
+// render.density_filter auto (render/filter_probe.h): the probe's measure of the texture unit's
+// weights, and what follows from it. Where it finds them exact (within 2^-16 of the 8 texels'
+// spread; lavapipe: float weights, ~7e-8), the filtered lookup into a real atlas must agree with
+// the exact field to that precision as well (plus the atlas coordinate's float rounding), and the
+// estimators must read through the filter with auto; elsewhere they must read 8 texels. exact
+// never uses the filter, biased-hardware always.
+TEST_F(GpuShared, FilterProbeDecidesAutoAndAgreesWithTheAtlasLookups) {
+  const double probed = filterWeightError(ctx(), compiler());
+  std::printf("[filter] texture unit weights within %.3g of the spread (subTexelPrecisionBits %u)\n", probed,
+              ctx().limits().subTexelPrecisionBits);
+  EXPECT_EQ(filterWeightError(ctx(), compiler()), probed) << "measured once per context";
+  const bool exactFilter = probed <= kExactFilterTolerance;
+  EXPECT_EQ(useHardwareFilter(ctx(), compiler(), "auto"), exactFilter);
+  EXPECT_FALSE(useHardwareFilter(ctx(), compiler(), "exact"));
+  EXPECT_TRUE(useHardwareFilter(ctx(), compiler(), "biased-hardware"));
+  if (!exactFilter) return;
+  auto grid = test::makeNoiseGrid(40, 0.05);
+  LoadedGrid loaded;
+  loaded.grid = grid;
+  BakedVolume bake = bakeVolume(loaded);
+  GpuVolumeResources volume(ctx(), bake, 1.0f);
+  const int n = 4096;
+  std::vector<KernelCase> cases(n);
+  sh::RngState setup = sh::rng_init(glm::uvec2(7, 8), 9, sh::RNG_STREAM_TEST, 13);
+  for (int i = 0; i < n; ++i) {
+    glm::vec3 p = glm::vec3(-2.0f) + 44.0f * glm::vec3(sh::rng_float(setup), sh::rng_float(setup), sh::rng_float(setup));
+    if (i % 4 == 0) p = glm::floor(p);
+    cases[i].point = glm::vec4(p, 0.0f);
+    cases[i].dir = glm::vec4(0.0f, 0.0f, 1.0f, 0.0f);
+  }
+  const std::vector<KernelResult> filtered = runKernels(volume, cases, {{"PLUME_HW_FILTER", "1"}});
+  // The atlas coordinate (texel + f + 0.5) / size in float: its fraction is good to the ulp of
+  // the largest atlas coordinate, as the exact lookup's is to that of the index-space point.
+  const glm::ivec3 extent = bake.atlasTexels;
+  const double coordinateUlp = std::ldexp(1.0, -23) * double(std::max({extent.x, extent.y, extent.z}));
+  int outside = 0;
+  double worst = 0;
+  for (int i = 0; i < n; ++i) {
+    const glm::vec3 p = glm::vec3(cases[i].point);
+    const float exact = sampleDensity(bake, p);
+    float lo = exact, hi = exact;
+    for (int c = 0; c < 8; ++c) {
+      const float v = sampleDensity(bake, glm::floor(p) + glm::vec3(c & 1, (c >> 1) & 1, (c >> 2) & 1));
+      lo = std::min(lo, v);
+      hi = std::max(hi, v);
+    }
+    const double err = std::abs(double(filtered[i].phase.z) - exact);
+    worst = std::max(worst, err / std::max(1e-30, double(hi - lo)));
+    outside += err > 3.0 * (kExactFilterTolerance + 2.0 * coordinateUlp) * (hi - lo) + 1e-6 * std::max(1.0f, exact);
+  }
+  std::printf("[filter] atlas lookups: worst error %.3g of the 8 voxels' spread\n", worst);
+  EXPECT_EQ(outside, 0) << "worst " << worst << " of the spread";
 }
 
 // A texel buffer longer than the device allows is bad input (its size follows from the scene),

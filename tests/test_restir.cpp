@@ -227,6 +227,25 @@ TEST_F(GpuRestir, TemporalAndSpatialStillCameraMatchesReference) {
   expectMatches(run, reference(s, grid, 512), "temporal_still");
 }
 
+// The same with render.density_filter = exact (8 texel reads with exact weights): the default,
+// auto, reads through the texture unit where its filter is measured exact (lavapipe), so this keeps
+// the 8 reads tested on such a device (candidates, the temporal history's lookups, shading).
+TEST_F(GpuRestir, ExactLookupsTemporalAndSpatialMatchReference) {
+  Scene s = baseScene(16);
+  s.render.densityFilter = "exact";
+  auto grid = test::makeNoiseGrid(40, 1.0 / 20, 2);
+  RestirOptions o;
+  o.radius = 6;
+  {
+    Restir probe(ctx(), compiler(), s, o);
+    EXPECT_FALSE(probe.features().hardwareFilter);
+  }
+  RunSpec spec;
+  spec.framesPerRun = 4;
+  RestirRun run = runRestir(ctx(), compiler(), s, o, spec, [&](int) { return grid; });
+  expectMatches(run, reference(s, grid, 512), "temporal_still_exact");
+}
+
 // Five lights: each candidate vertex samples one light chosen in proportion to its estimated
 // power (render/restir.cpp); a dim light must still be found.
 TEST_F(GpuRestir, ManyLightsChosenByPowerMatchReference) {

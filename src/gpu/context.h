@@ -18,6 +18,7 @@
 
 #include <atomic>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -56,6 +57,10 @@ class Context {
   bool subgroupBallot() const { return subgroupBallot_; }
   bool validationEnabled() const { return validation_; }
   uint64_t validationMessages() const { return validationMessages_.load(); }
+  // The texture unit's trilinear weight error on this device, measured once by a higher layer
+  // (render/filter_probe.h) and kept here for the context's life; nullopt until then.
+  std::optional<double> filterWeightError() const { return filterWeightError_; }
+  void setFilterWeightError(double e) { filterWeightError_ = e; }
 
   // A memory type allowed by typeBits with all of `required` (and `preferred` if possible).
   uint32_t findMemoryType(uint32_t typeBits, VkMemoryPropertyFlags required,
@@ -87,6 +92,7 @@ class Context {
   bool validation_ = false;
   bool subgroupBallot_ = false;
   std::atomic<uint64_t> validationMessages_{0};
+  std::optional<double> filterWeightError_;
 };
 
 }  // namespace plume::gpu

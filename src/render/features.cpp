@@ -55,7 +55,6 @@ FeatureSet featuresOf(const Scene& scene) {
     f.blackbody |= m.emission && m.emission->blackbody;
   }
   f.surfaces = !scene.surfaces.empty();
-  f.hardwareFilter = scene.render.densityFilter == "biased-hardware";
   f.emitters = std::any_of(scene.surfaces.begin(), scene.surfaces.end(), [](const Surface& s) { return s.emits(); });
   // With emission a path also gathers light along the segment after its last scattering, so one
   // bounce already needs the path loop.

@@ -18,8 +18,9 @@ struct FeatureSet {
   bool sun = false, point = false, environment = false, envMap = false, multiBounce = false;
   bool emission = false, blackbody = false;  // the medium emits (blackbody: its colour form)
   bool surfaces = false, emitters = false;   // the scene has surfaces (emitters: some emit)
-  // render.density_filter = biased-hardware: the grids are read through the texture unit's
-  // trilinear filter (volume/grid.glsl), not with exact weights. A setting, named biased.
+  // The grids are read through the texture unit's trilinear filter (volume/grid.glsl), not with
+  // exact weights: render.density_filter biased-hardware, or auto on a device whose filter is
+  // measured exact (render/filter_probe.h). Set by the estimators, which hold the device.
   bool hardwareFilter = false;
   // The kernel benchmark's event counters in the walk (shared/kernel_counters.h): never a scene
   // feature, set only by `plume bench --kernels` (EstimatorOptions::kernelCounters).

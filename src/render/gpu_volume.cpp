@@ -163,7 +163,7 @@ void GpuVolumeResources::requireLinearFilter() const {
   if (!ok) {
     throw InputError(std::string("render.density_filter: biased-hardware: the device cannot filter the ") +
                      (atlas_.linearFilter() ? "emission atlas (R32F)" : "brick atlas") +
-                     " linearly; use exact (the default)");
+                     " linearly; use auto (the default) or exact");
   }
 }
 

@@ -2,6 +2,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "render/filter_probe.h"
 #include "render/gpu_scene.h"
 #include "shaders/shared/pt_wave.h"
 
@@ -22,6 +23,7 @@ PathTracer::PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const S
     : ctx_(ctx), scene_(scene), features_(featuresOf(scene)), compiler_(compiler),
       timer_(ctx, 2 * kBouncesPerSubmit + 1) {
   features_.kernelCounters = kernelCounters;
+  features_.hardwareFilter = useHardwareFilter(ctx, compiler, scene.render.densityFilter);  // render/filter_probe.h
   envMap_ = std::make_unique<GpuEnvironmentMap>(ctx, scene);
   if (features_.surfaces) {
     surfaces_ = std::make_unique<GpuSurfaces>(ctx, scene);

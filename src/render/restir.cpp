@@ -2,6 +2,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "render/filter_probe.h"
 #include "render/gpu_scene.h"
 
 #include <glm/glm.hpp>
@@ -99,6 +100,7 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
                bool kernelCounters)
     : ctx_(ctx), scene_(scene), options_(options), features_(featuresOf(scene)), timer_(ctx, 32) {
   features_.kernelCounters = kernelCounters;
+  features_.hardwareFilter = useHardwareFilter(ctx, compiler, scene.render.densityFilter);  // render/filter_probe.h
   envMap_ = std::make_unique<GpuEnvironmentMap>(ctx, scene);  // bad maps fail before compiling
   if (features_.surfaces) {
     surfaces_ = std::make_unique<GpuSurfaces>(ctx, scene);

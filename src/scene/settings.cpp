@@ -22,10 +22,11 @@ const std::vector<SettingDesc>& renderSettingsTable() {
       {"rr_start_bounce", "first bounce at which Russian roulette may end a path",
        &RenderSettings::rrStartBounce, 1, 100000, {}},
       {"density_filter",
-       "GPU density and emission lookups: exact (8 texel reads, the CPU reference's field) or biased-hardware "
-       "(the texture unit's trilinear filter: faster, biased by the device's rounding of the weights, "
-       "8 bits on most GPUs; README \"The scene file\")",
-       &RenderSettings::densityFilter, 0, 0, {"exact", "biased-hardware"}},
+       "GPU density and emission lookups: auto (the texture unit's trilinear filter where this device's "
+       "filter is measured exact, weights within 2^-16 as on lavapipe; 8 texel reads elsewhere), exact (8 texel "
+       "reads, the CPU reference's field) or biased-hardware (the texture unit's filter on any device: faster, "
+       "biased by the device's rounding of the weights, 8 bits on most GPUs; README \"The scene file\")",
+       &RenderSettings::densityFilter, 0, 0, {"auto", "exact", "biased-hardware"}},
       {"restir_candidates", "ReSTIR: candidate paths M per pixel and frame", &RenderSettings::restirCandidates, 1, 64, {}},
       {"restir_candidates_moving",
        "ReSTIR: candidate paths per pixel in frames whose camera moved (0 = restir_candidates). A moving "

@@ -21,9 +21,10 @@ struct RenderSettings {
   int frameLast = 1;
   int rrStartBounce = 3;     // Russian roulette from this bounce on (unbiased)
   // How the GPU estimators interpolate the density and emission grids: "exact" (8 texel reads,
-  // exact weights: the field the CPU reference tracks) or "biased-hardware" (the texture unit's
-  // trilinear filter: fewer instructions, weights rounded to the device's sub-texel precision).
-  std::string densityFilter = "exact";
+  // exact weights: the field the CPU reference tracks), "biased-hardware" (the texture unit's
+  // trilinear filter: fewer instructions, weights rounded to the device's sub-texel precision) or
+  // "auto": the filter where its weights are measured exact on the device (render/filter_probe.h).
+  std::string densityFilter = "auto";
   // Volumetric ReSTIR (DESIGN §4.2; src/render/restir.h)
   int restirCandidates = 4;          // M: candidate paths per pixel and frame
   int restirCandidatesMoving = 0;    // ... in frames whose camera moved (0: restirCandidates)
