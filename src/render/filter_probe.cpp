@@ -21,7 +21,7 @@ namespace {
 constexpr uint32_t kProbePoints = 4096;
 
 // The worst error over the probe's points for one image format, in units of the spread (7).
-double probeFormat(gpu::Context& ctx, gpu::ShaderCompiler& compiler, VkFormat format) {
+double probeFormat(gpu::Context& ctx, const std::vector<uint32_t>& spirv, VkFormat format) {
   const bool half = format == VK_FORMAT_R16_SFLOAT;
   gpu::Image3D image(ctx, glm::ivec3(2), format, half ? 2 : 4, "filter probe image");
   if (!image.linearFilter()) return std::numeric_limits<double>::infinity();
@@ -35,7 +35,7 @@ double probeFormat(gpu::Context& ctx, gpu::ShaderCompiler& compiler, VkFormat fo
     image.upload(values.data(), values.size() * sizeof(float));
   }
   gpu::Buffer out(ctx, kProbePoints * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "filter probe results");
-  gpu::ComputePass pass(ctx, compiler.compile("passes/filter_probe.comp", {}),
+  gpu::ComputePass pass(ctx, spirv,
                         {gpu::BindingType::SampledImage, gpu::BindingType::StorageBuffer}, 0, "filter probe",
                         glm::uvec3(64, 1, 1));
   pass.set.bind(0, image);
@@ -52,7 +52,8 @@ double probeFormat(gpu::Context& ctx, gpu::ShaderCompiler& compiler, VkFormat fo
 
 double filterWeightError(gpu::Context& ctx, gpu::ShaderCompiler& compiler) {
   if (std::optional<double> known = ctx.filterWeightError()) return *known;
-  const double e = std::max(probeFormat(ctx, compiler, VK_FORMAT_R16_SFLOAT), probeFormat(ctx, compiler, VK_FORMAT_R32_SFLOAT));
+  const std::vector<uint32_t> spirv = compiler.compile("passes/filter_probe.comp", {});
+  const double e = std::max(probeFormat(ctx, spirv, VK_FORMAT_R16_SFLOAT), probeFormat(ctx, spirv, VK_FORMAT_R32_SFLOAT));
   ctx.setFilterWeightError(e);
   logInfo(strf("%s: the texture unit's trilinear weights are exact to %.3g of the texels' spread (%s)",
                 ctx.deviceName().c_str(), e, e <= kExactFilterTolerance ? "density_filter auto reads through it"
