@@ -52,6 +52,51 @@ class GpuShared : public test::GpuTest {
     out.download(results.data(), n * sizeof(KernelResult));
     return results;
   }
+
+  // The texture unit's filtered lookup (PLUME_HW_FILTER) against the exact CPU field at 4096
+  // points of a noise grid's atlas (a quarter at voxel centres and brick borders), drawn from
+  // `seed`: per point the exact value, the spread of the 8 voxels around it (a voxel's value is the
+  // field at its centre) and the filtered value's error. Skips where the atlas cannot be filtered.
+  struct FilteredLookup {
+    float exact, spread;
+    double error;
+  };
+  std::vector<FilteredLookup> filteredLookups(uint32_t seed, glm::ivec3* atlasTexels = nullptr) {
+    auto grid = test::makeNoiseGrid(40, 0.05);
+    LoadedGrid loaded;
+    loaded.grid = grid;
+    BakedVolume bake = bakeVolume(loaded);
+    if (atlasTexels) *atlasTexels = bake.atlasTexels;
+    GpuVolumeResources volume(ctx(), bake, 1.0f);
+    try {
+      volume.requireLinearFilter();
+    } catch (const InputError&) {
+      return {};
+    }
+    const int n = 4096;
+    std::vector<KernelCase> cases(n);
+    sh::RngState setup = sh::rng_init(glm::uvec2(5, 6), 7, sh::RNG_STREAM_TEST, seed);
+    for (int i = 0; i < n; ++i) {
+      glm::vec3 p = glm::vec3(-2.0f) + 44.0f * glm::vec3(sh::rng_float(setup), sh::rng_float(setup), sh::rng_float(setup));
+      if (i % 4 == 0) p = glm::floor(p);  // voxel centres and brick borders
+      cases[i].point = glm::vec4(p, 0.0f);
+      cases[i].dir = glm::vec4(0.0f, 0.0f, 1.0f, 0.0f);
+    }
+    const std::vector<KernelResult> gpu = runKernels(volume, cases, {{"PLUME_HW_FILTER", "1"}});
+    std::vector<FilteredLookup> out(n);
+    for (int i = 0; i < n; ++i) {
+      const glm::vec3 p = glm::vec3(cases[i].point);
+      const float exact = sampleDensity(bake, p);
+      float lo = exact, hi = exact;
+      for (int c = 0; c < 8; ++c) {
+        const float v = sampleDensity(bake, glm::floor(p) + glm::vec3(c & 1, (c >> 1) & 1, (c >> 2) & 1));
+        lo = std::min(lo, v);
+        hi = std::max(hi, v);
+      }
+      out[i] = {exact, hi - lo, std::abs(double(gpu[i].phase.z) - exact)};
+    }
+    return out;
+  }
 };
 
 }  // namespace
@@ -109,47 +154,19 @@ TEST_F(GpuShared, GlslAndCppAgree) {
 // sub-texel precision (VkPhysicalDeviceLimits::subTexelPrecisionBits), so the error is at most
 // 3 * 2^-bits of the spread of the 8 voxels (lavapipe filters floats with float weights: ~0).
 TEST_F(GpuShared, HardwareFilteredDensityIsWithinTheDeviceWeightPrecision) {
-  auto grid = test::makeNoiseGrid(40, 0.05);
-  LoadedGrid loaded;
-  loaded.grid = grid;
-  BakedVolume bake = bakeVolume(loaded);
-  GpuVolumeResources volume(ctx(), bake, 1.0f);
-  try {
-    volume.requireLinearFilter();
-  } catch (const InputError& e) {
-    GTEST_SKIP() << e.what();
-  }
-  const int n = 4096;
-  std::vector<KernelCase> cases(n);
-  sh::RngState setup = sh::rng_init(glm::uvec2(5, 6), 7, sh::RNG_STREAM_TEST, 11);
-  for (int i = 0; i < n; ++i) {
-    glm::vec3 p = glm::vec3(-2.0f) + 44.0f * glm::vec3(sh::rng_float(setup), sh::rng_float(setup), sh::rng_float(setup));
-    if (i % 4 == 0) p = glm::floor(p);  // voxel centres and brick borders
-    cases[i].point = glm::vec4(p, 0.0f);
-    cases[i].dir = glm::vec4(0.0f, 0.0f, 1.0f, 0.0f);
-  }
-  const std::vector<KernelResult> gpuResults = runKernels(volume, cases, {{"PLUME_HW_FILTER", "1"}});
-
+  const std::vector<FilteredLookup> lookups = filteredLookups(11);
+  if (lookups.empty()) GTEST_SKIP() << "the device cannot filter the atlas linearly";
   const double weightStep = std::ldexp(1.0, -int(ctx().limits().subTexelPrecisionBits));
-  int outside = 0, nonZero = 0;
+  size_t outside = 0, nonZero = 0;
   double worst = 0;
-  for (int i = 0; i < n; ++i) {
-    const glm::vec3 p = glm::vec3(cases[i].point);
-    const float exact = sampleDensity(bake, p);
-    float lo = exact, hi = exact;  // the 8 voxels' spread (a voxel's value is the field at its centre)
-    for (int c = 0; c < 8; ++c) {
-      const float v = sampleDensity(bake, glm::floor(p) + glm::vec3(c & 1, (c >> 1) & 1, (c >> 2) & 1));
-      lo = std::min(lo, v);
-      hi = std::max(hi, v);
-    }
-    const double err = std::abs(double(gpuResults[i].phase.z) - exact);
-    worst = std::max(worst, err);
-    outside += err > 3.0 * weightStep * (hi - lo) + 1e-6 * std::max(1.0f, exact);
-    nonZero += exact > 0.0f;
+  for (const FilteredLookup& l : lookups) {
+    worst = std::max(worst, l.error);
+    outside += l.error > 3.0 * weightStep * l.spread + 1e-6 * std::max(1.0f, l.exact);
+    nonZero += l.exact > 0.0f;
   }
-  EXPECT_EQ(outside, 0) << "worst difference " << worst << " (subTexelPrecisionBits "
-                        << ctx().limits().subTexelPrecisionBits << ")";
-  EXPECT_GT(nonZero, n / 4) << "the cases must mostly fall where the grid has density";
+  EXPECT_EQ(outside, 0u) << "worst difference " << worst << " (subTexelPrecisionBits "
+                         << ctx().limits().subTexelPrecisionBits << ")";
+  EXPECT_GT(nonZero, lookups.size() / 4) << "the cases must mostly fall where the grid has density";
 }
 
 // render.density_filter auto (render/filter_probe.h): the probe's measure of the texture unit's
@@ -168,42 +185,20 @@ TEST_F(GpuShared, FilterProbeDecidesAutoAndAgreesWithTheAtlasLookups) {
   EXPECT_FALSE(useHardwareFilter(ctx(), compiler(), "exact"));
   EXPECT_TRUE(useHardwareFilter(ctx(), compiler(), "biased-hardware"));
   if (!exactFilter) return;
-  auto grid = test::makeNoiseGrid(40, 0.05);
-  LoadedGrid loaded;
-  loaded.grid = grid;
-  BakedVolume bake = bakeVolume(loaded);
-  GpuVolumeResources volume(ctx(), bake, 1.0f);
-  const int n = 4096;
-  std::vector<KernelCase> cases(n);
-  sh::RngState setup = sh::rng_init(glm::uvec2(7, 8), 9, sh::RNG_STREAM_TEST, 13);
-  for (int i = 0; i < n; ++i) {
-    glm::vec3 p = glm::vec3(-2.0f) + 44.0f * glm::vec3(sh::rng_float(setup), sh::rng_float(setup), sh::rng_float(setup));
-    if (i % 4 == 0) p = glm::floor(p);
-    cases[i].point = glm::vec4(p, 0.0f);
-    cases[i].dir = glm::vec4(0.0f, 0.0f, 1.0f, 0.0f);
-  }
-  const std::vector<KernelResult> filtered = runKernels(volume, cases, {{"PLUME_HW_FILTER", "1"}});
+  glm::ivec3 extent;
+  const std::vector<FilteredLookup> lookups = filteredLookups(13, &extent);
+  ASSERT_FALSE(lookups.empty()) << "the probe found the filter exact, so the atlas can be filtered";
   // The atlas coordinate (texel + f + 0.5) / size in float: its fraction is good to the ulp of
   // the largest atlas coordinate, as the exact lookup's is to that of the index-space point.
-  const glm::ivec3 extent = bake.atlasTexels;
   const double coordinateUlp = std::ldexp(1.0, -23) * double(std::max({extent.x, extent.y, extent.z}));
-  int outside = 0;
+  size_t outside = 0;
   double worst = 0;
-  for (int i = 0; i < n; ++i) {
-    const glm::vec3 p = glm::vec3(cases[i].point);
-    const float exact = sampleDensity(bake, p);
-    float lo = exact, hi = exact;
-    for (int c = 0; c < 8; ++c) {
-      const float v = sampleDensity(bake, glm::floor(p) + glm::vec3(c & 1, (c >> 1) & 1, (c >> 2) & 1));
-      lo = std::min(lo, v);
-      hi = std::max(hi, v);
-    }
-    const double err = std::abs(double(filtered[i].phase.z) - exact);
-    worst = std::max(worst, err / std::max(1e-30, double(hi - lo)));
-    outside += err > 3.0 * (kExactFilterTolerance + 2.0 * coordinateUlp) * (hi - lo) + 1e-6 * std::max(1.0f, exact);
+  for (const FilteredLookup& l : lookups) {
+    worst = std::max(worst, l.error / std::max(1e-30, double(l.spread)));
+    outside += l.error > 3.0 * (kExactFilterTolerance + 2.0 * coordinateUlp) * l.spread + 1e-6 * std::max(1.0f, l.exact);
   }
   std::printf("[filter] atlas lookups: worst error %.3g of the 8 voxels' spread\n", worst);
-  EXPECT_EQ(outside, 0) << "worst " << worst << " of the spread";
+  EXPECT_EQ(outside, 0u) << "worst " << worst << " of the spread";
 }
 
 // A texel buffer longer than the device allows is bad input (its size follows from the scene),

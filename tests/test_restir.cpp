@@ -164,6 +164,37 @@ void expectMatches(const RestirRun& run, const Image& ref, const std::string& na
   std::printf("[restir] %s: %.1f s\n", name.c_str(), run.seconds);
 }
 
+// Frames 1 to 4 of one run of `o` on `s`: frame f over volumes[f - 1] with volumes[f - 2] as the
+// history's, or over volumes[0] throughout where there is one volume.
+std::vector<Image> restirFrames(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& s,
+                                const RestirOptions& o,
+                                const std::vector<std::unique_ptr<GpuVolumeResources>>& volumes) {
+  Restir restir(ctx, compiler, s, o);
+  const bool animated = volumes.size() > 1;
+  std::vector<Image> out;
+  for (int f = 1; f <= 4; ++f) {
+    const size_t cur = animated ? size_t(f - 1) : 0, prev = animated ? size_t(std::max(f - 2, 0)) : 0;
+    restir.setVolumes(*volumes[cur], *volumes[prev]);
+    out.push_back(restir.renderFrame(f, 1));
+  }
+  return out;
+}
+
+// Channels of two runs' frames whose bits differ, and channels lit in the first run.
+struct BitDifferences {
+  size_t differ = 0, lit = 0;
+};
+BitDifferences bitDifferences(const std::vector<Image>& a, const std::vector<Image>& b) {
+  BitDifferences d;
+  for (size_t f = 0; f < a.size(); ++f) {
+    for (size_t i = 0; i < a[f].rgb.size(); ++i) {
+      d.differ += std::memcmp(&a[f].rgb[i], &b[f].rgb[i], sizeof(float)) != 0 ? 1 : 0;
+      d.lit += a[f].rgb[i] > 0.0f ? 1 : 0;
+    }
+  }
+  return d;
+}
+
 }  // namespace
 
 
@@ -428,23 +459,10 @@ TEST_F(GpuRestir, PixelsThatMissTheVolumeSkipTheWalksAndKeepTheImage) {
       o.mis = c.mis;
       o.prefix = c.prefix;
       o.cullOutside = cull;
-      Restir restir(ctx(), compiler(), s, o);
-      std::vector<Image> out;
-      for (int f = 1; f <= 4; ++f) {
-        const size_t cur = c.animated ? size_t(f - 1) : 0, prev = c.animated ? size_t(std::max(f - 2, 0)) : 0;
-        restir.setVolumes(*volumes[cur], *volumes[prev]);
-        out.push_back(restir.renderFrame(f, 1));
-      }
-      return out;
+      return restirFrames(ctx(), compiler(), s, o, volumes);
     };
     const std::vector<Image> culled = frames(true), walked = frames(false);
-    size_t differ = 0, lit = 0;
-    for (size_t f = 0; f < culled.size(); ++f) {
-      for (size_t i = 0; i < culled[f].rgb.size(); ++i) {
-        differ += culled[f].rgb[i] != walked[f].rgb[i] ? 1 : 0;
-        lit += walked[f].rgb[i] > 0.0f ? 1 : 0;
-      }
-    }
+    const auto [differ, lit] = bitDifferences(walked, culled);
     // The split the last frame used: the frame's camera over its volume's box.
     const VolumeFootprint& footprint = volumes.back()->footprint();
     const PixelOrder order = volumePixelOrder(gpuCamera(s.camera, 4), s.camera.width, s.camera.height, footprint);
@@ -495,23 +513,10 @@ TEST_F(GpuRestir, PathVerticesInAStorageBufferGiveTheSameFrames) {
       o.radius = 6;
       o.prefix = c.prefix;
       o.verticesInStorageBuffer = inBuffer;
-      Restir restir(ctx(), compiler(), s, o);
-      std::vector<Image> out;
-      for (int f = 1; f <= 4; ++f) {
-        const size_t cur = c.animated ? size_t(f - 1) : 0, prev = c.animated ? size_t(std::max(f - 2, 0)) : 0;
-        restir.setVolumes(*volumes[cur], *volumes[prev]);
-        out.push_back(restir.renderFrame(f, 1));
-      }
-      return out;
+      return restirFrames(ctx(), compiler(), s, o, volumes);
     };
     const std::vector<Image> texels = frames(false), buffer = frames(true);
-    size_t differ = 0, lit = 0;
-    for (size_t f = 0; f < texels.size(); ++f) {
-      for (size_t i = 0; i < texels[f].rgb.size(); ++i) {
-        differ += std::memcmp(&texels[f].rgb[i], &buffer[f].rgb[i], sizeof(float)) != 0 ? 1 : 0;
-        lit += texels[f].rgb[i] > 0.0f ? 1 : 0;
-      }
-    }
+    const auto [differ, lit] = bitDifferences(texels, buffer);
     std::printf("[restir] vertices in a storage buffer, %s: %zu of %zu lit channels differ\n", c.name, differ, lit);
     EXPECT_EQ(differ, 0u) << c.name << ": the vertices' storage must not change any pixel";
     EXPECT_GT(lit, texels.size() * texels[0].rgb.size() / 2) << c.name << ": too few lit channels";
