@@ -128,12 +128,13 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   // the texel buffers cannot hold them and a storage buffer can (desktop GPU drivers publish 2^27
   // texels, as lavapipe, and 2-4 GiB storage buffers: 3840x2160 at 8 bounces needs 174 M texels).
   const size_t stateTexels = shared::RS_STATE_SLOTS + (features_.emitters ? shared::RS_LAMP_SLOTS : 0);
-  const size_t pixelCount = size_t(scene.camera.width) * size_t(scene.camera.height);
-  const size_t vertexTexels = kSets * size_t(std::max(1, vertices - 1));  // per pixel
+  const size_t pixels = size_t(scene.camera.width) * size_t(scene.camera.height);
+  const uint32_t stride = uint32_t(std::max(1, vertices - 1));  // vertex slots per pixel and set
+  const size_t vertexTexels = kSets * stride;                     // per pixel
   {
     const VkPhysicalDeviceLimits& lim = ctx.limits();
-    const bool texelsFit = pixelCount * vertexTexels <= lim.maxTexelBufferElements;
-    const bool bufferFits = pixelCount * vertexTexels * sizeof(glm::vec4) <= lim.maxStorageBufferRange;
+    const bool texelsFit = pixels * vertexTexels <= lim.maxTexelBufferElements;
+    const bool bufferFits = pixels * vertexTexels * sizeof(glm::vec4) <= lim.maxStorageBufferRange;
     // Where neither holds them, the larger kind names the limit in the message below.
     const bool bufferLarger = uint64_t(lim.maxStorageBufferRange) > uint64_t(lim.maxTexelBufferElements) * sizeof(glm::vec4);
     verticesInBuffer_ = options_.verticesInStorageBuffer || (!texelsFit && (bufferFits || bufferLarger));
@@ -228,8 +229,6 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   }
 
   const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-  const size_t pixels = size_t(scene.camera.width) * scene.camera.height;
-  const uint32_t stride = uint32_t(std::max(1, vertices - 1));
   frameBuffer_ = gpu::Buffer(ctx, sizeof(shared::GpuFrame), storage, "frame parameters");
   const std::vector<shared::GpuLight> lights = gpuLights(scene);
   lightBuffer_ = lightTexels(ctx, lights);
