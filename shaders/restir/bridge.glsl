@@ -245,7 +245,11 @@ float rs_resample_light(PathVertex vx, vec3 f, inout RngState rng, out uint ligh
 uint rs_slot(uint set, uint pixelIndex) { return set * rsp.pixelCount + pixelIndex; }
 uint rs_bounce_base(uint set, uint pixelIndex) { return rs_slot(set, pixelIndex) * rsp.bounceStride; }
 
-RsPacked rs_packed(uvec4 words) { return RsPacked(uintBitsToFloat(words.x), uintBitsToFloat(words.y), uintBitsToFloat(words.z), words.w); }
+// RsPacked from its four words as stored (restir/bindings.glsl rsReservoirTexels), and back.
+RsPacked rs_packed(uvec4 words) {
+  return RsPacked(uintBitsToFloat(words.x), uintBitsToFloat(words.y), uintBitsToFloat(words.z), words.w);
+}
+uvec4 rs_words(RsPacked p) { return uvec4(floatBitsToUint(vec3(p.w_sum, p.p_hat, p.W)), p.M_fixed); }
 
 RsReservoir rs_load(uint set, uint pixelIndex) {
   bool dropped;
@@ -255,8 +259,7 @@ RsReservoir rs_load(uint set, uint pixelIndex) {
 }
 
 void rs_store(uint set, uint pixelIndex, RsReservoir r) {
-  RsPacked p = rs_pack(r);
-  imageStore(rsReservoirTexels, int(rs_slot(set, pixelIndex)), uvec4(floatBitsToUint(vec3(p.w_sum, p.p_hat, p.W)), p.M_fixed));
+  imageStore(rsReservoirTexels, int(rs_slot(set, pixelIndex)), rs_words(rs_pack(r)));
 }
 
 RsPathHead rs_load_head(uint set, uint pixelIndex) {

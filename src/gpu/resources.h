@@ -57,7 +57,8 @@ class TexelBuffer {
   TexelBuffer() = default;
   // `format`: VK_FORMAT_R32_SFLOAT, VK_FORMAT_R32_UINT (4 bytes per element),
   // VK_FORMAT_R32G32B32A32_SFLOAT or _UINT (16); `count` elements, uploaded from `data` where
-  // not null.
+  // not null. `storage`: a storage texel buffer (imageBuffer, read and written; zeroed with
+  // fillZero) instead of a uniform one (samplerBuffer, read only).
   TexelBuffer(Context& ctx, const void* data, size_t count, VkFormat format, const std::string& name,
               bool storage = false);
   ~TexelBuffer();

@@ -247,16 +247,16 @@ void Viewer::applyRequests(const UiRequests& req) {
 
 void Viewer::renderAndPresent(bool capture) {
   using Clock = std::chrono::steady_clock;
-  auto since = [](Clock::time_point& t) {
+  Clock::time_point phase = Clock::now();  // the start of the phase being timed (host_)
+  auto since = [&phase]() {
     const Clock::time_point now = Clock::now();
-    const double ms = std::chrono::duration<double, std::milli>(now - t).count();
-    t = now;
+    const double ms = std::chrono::duration<double, std::milli>(now - phase).count();
+    phase = now;
     return ms;
   };
-  Clock::time_point t = Clock::now();
   std::optional<uint32_t> index = swapchain_->acquire(window_->framebufferSize());
   if (!index) return;
-  const double acquireMs = since(t);
+  const double acquireMs = since();
   if (displayTimed_) {
     PassTimes t = displayTimer_->read();
     stats_.passes = rendererTimes_;
@@ -279,7 +279,7 @@ void Viewer::renderAndPresent(bool capture) {
     haveImage_ = true;
   }
   stats_.samples = renderer_->samplesSoFar();
-  const double rendererMs = since(t);
+  const double rendererMs = since();
   VkCommandBuffer cmd = swapchain_->commandBuffer();
   const VkExtent2D extent = swapchain_->extent();
   displayTimer_->reset(cmd);
@@ -293,13 +293,13 @@ void Viewer::renderAndPresent(bool capture) {
   ui_->record(cmd);
   vkCmdEndRenderPass(cmd);
   if (capture) readback_->record(cmd, swapchain_->image(*index), extent);
-  const double recordMs = since(t);
+  const double recordMs = since();
   swapchain_->submitAndPresent(*index, window_->framebufferSize());
   if (timeHost_) {
     host_.acquire += acquireMs;
     host_.renderer += rendererMs;
     host_.record += recordMs;
-    host_.present += since(t);
+    host_.present += since();
     ++host_.frames;
   }
 }
