@@ -84,8 +84,11 @@ TEST_F(ExtremeSuite, DenseAndBright) {
   checkCase(ctx(), compiler(), c, {256, 256, 256});
 }
 
+// 512 ReSTIR runs: with the candidates' delta tracking in the mean field (session 27) 128 runs
+// left one pixel at z -5.46, the light forward-scattered through the slab a rare bright event
+// (512 runs: worst pixel z -2.66, relMSE 0.079; the closed-form sampling before it: -2.71, 0.100).
 TEST_F(ExtremeSuite, StronglyForwardScatteringBacklit) {
-  checkCase(ctx(), compiler(), caseNamed("g+0.99_backlit", {16, 256}), {});
+  checkCase(ctx(), compiler(), caseNamed("g+0.99_backlit", {16, 256}), {512, 1024, 512});
 }
 
 TEST_F(ExtremeSuite, StronglyBackwardScattering) {

@@ -1,6 +1,6 @@
 // Candidate paths (DESIGN §4.2 step 1). M random walks per pixel, each from its own uniform
-// position (u, v) in the pixel: each vertex's distance comes from coarse tracking in the mean
-// field (pdf sigma_c exp(-tau_c), closed form; volume/walk.glsl vol_mean_sample), each further
+// position (u, v) in the pixel: each vertex's distance comes from delta tracking in the mean
+// field against the brick majorants (pdf sigma_c exp(-tau_c); volume/walk.glsl vol_mean_sample), each further
 // direction from the vertex's scattering (HG), and every vertex ends one candidate with a light
 // sample: a light chosen in proportion to its estimated power (render/restir.cpp lightChoice),
 // or, with PLUME_RS_LIGHT_CANDIDATES = L > 1 (render.restir_light_candidates), the survivor of L
@@ -11,7 +11,12 @@
 //   p(y) = prod_i sigma_c(x_i) exp(-tau_i) * prod_{i>=2} phase_i * prod q (Russian roulette)
 //          * p_light,
 // and only "vertex j of some walk, light l" can produce it, so the M walks give it the MIS
-// weight 1/M (GRIS allows candidates of one walk to be dependent: only marginals matter). With an
+// weight 1/M (GRIS allows candidates of one walk to be dependent: only marginals matter). The
+// target's transmittance of each segment, exp(-tau_c) of the same mean field (restir/bridge.glsl
+// rs_transmittance), is the source pdf's too, so the walks carry neither and a candidate's weight
+// p̂ / p needs no optical depth (the target clamps tau_c at VOL_MAX_TAU = 80, where the two part:
+// a path beyond it is sampled with probability below e^-80); the reservoir's p̂ of the selected
+// path, which reuse needs, is the target evaluated once on the stored path (rs_target). With an
 // emitting medium (PLUME_HAS_EMISSION) every vertex from the second on also ends a candidate with
 // its own emission (sigma_a Le at x_j, pdf without a light factor; light = RS_LIGHT_EMISSION), up
 // to vertex max_bounces + 1: both ends go through the one reservoir, so reuse shares good
@@ -175,8 +180,8 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
   uint uv = 0u;
   vec3 x = D.origin;
   vec3 w = vec3(0.0f);
-  vec3 f = vec3(1.0f);  // prefix of f_D with coarse transmittance (the target's)
-  float pdf = 1.0f;     // prefix of the source pdf
+  vec3 f = vec3(1.0f);  // prefix of f_D, and of the source pdf, without the transmittances
+  float pdf = 1.0f;     // exp(-tau_c) both hold (they cancel in the weights)
   float t1 = 0.0f;
   uint keep = 0u;   // vertices of this walk's selected candidate (0: none): copied when the walk ends
   uint kinds = 0u;  // this walk's vertex kinds so far (RsPathHead.kinds)
@@ -210,22 +215,19 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
     do {
       float t;
       float sigmaC;
-      float tau;
 #ifdef PLUME_HAS_SURFACES
       // The nearer of the mean field's collision and the first surface: the surface is reached
-      // with the probability of passing the mean field up to it, exp(-tau_c(0, t_hit)).
+      // with the probability of passing the mean field up to it, exp(-tau_c(0, t_hit)), the
+      // target's transmittance to it (neither is carried).
       BvhHit hit = bvh_closest(x, w, 0.0f, SURF_FAR);
       float tMax = hit.prim != BVH_NONE ? hit.t : DDA_INF;
-      bool collided = vol_mean_sample(x, w, tMax, rng_float(rng), t, sigmaC, tau);
+      bool collided = vol_mean_sample(x, w, tMax, rng, t, sigmaC);
       PathVertex vx;
       if (!collided) {
         if (hit.prim == BVH_NONE) break;
-        float trSurface = exp(-min(tau, VOL_MAX_TAU));  // tau: the mean field's depth to the surface
         t = hit.t;
         vec3 o = x;
         x += t * w;
-        pdf *= trSurface;
-        f *= trSurface;
         vx = vtx_surface(x, w, hit.prim, surf_shading_normal(hit.prim, vec2(hit.u, hit.v), surf_normal(hit.prim)));
         slot = vec4(w, t);
 #ifdef PLUME_RS_RECONNECT
@@ -251,16 +253,15 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
 #endif
       } else {
 #else
-      if (!vol_mean_sample(x, w, DDA_INF, rng_float(rng), t, sigmaC, tau)) break;
+      if (!vol_mean_sample(x, w, DDA_INF, rng, t, sigmaC)) break;
 #endif
-      float trTarget = exp(-min(tau, VOL_MAX_TAU));  // the target's transmittance (same field)
       x += t * w;
       float sigma = vol_sigma_t_world(VOL_CURRENT, x);
       // f = 0 for this path and every extension of it (sigmaC: an exact voxel's density at the
       // collision, 0 only by rounding at the edge of a zero region, a set of measure 0)
       if (!(sigma > 0.0f) || !(sigmaC > 0.0f)) break;
-      pdf *= sigmaC * exp(-tau);   // the sampling field's free-flight pdf
-      vec3 fArrive = f * trTarget * sigma;  // before x_j scatters or absorbs
+      pdf *= sigmaC;            // the free-flight pdf sigmaC exp(-tau_c), less the transmittance
+      vec3 fArrive = f * sigma;  // before x_j scatters or absorbs
       slot = vec4(w, t);
       f = fArrive * vtx_albedo(VERTEX_MEDIUM);
 #ifdef PLUME_HAS_SURFACES
@@ -347,10 +348,14 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
     return;
   }
   r.M = float(M);
-  rs_finalize(r);
-  if (r.W <= 0.0f) head.vertexCount = 0u;
-  rs_store(outSet, pixelIndex, r);
   rs_store_head(outSet, pixelIndex, head);
+#ifndef PLUME_RS_OUTSIDE
+  // The target of the selected path, with its transmittances (the weights' p̂ left them out).
+  r.p_hat = head.vertexCount > 0u && r.w_sum > 0.0f ? rs_target(D, outSet, pixelIndex) : 0.0f;
+#endif
+  rs_finalize(r);
+  if (r.W <= 0.0f) rs_clear_path(outSet, pixelIndex);
+  rs_store(outSet, pixelIndex, r);
 }
 
 #endif

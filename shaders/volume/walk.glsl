@@ -1,6 +1,6 @@
 // The one majorant walk (in the spirit of pbrt-v4's SampleT_maj): a ray is cut into segments of
 // a piecewise-constant field, and every tracker — delta tracking, ratio tracking, residual ratio
-// tracking, the mean field's optical depth and closed-form sampling — is this one loop with its
+// tracking, the mean field's optical depth and sampling in it — is this one loop with its
 // own "callbacks": what to do on entering a segment (vol_track_segment) and at each tentative
 // collision of the Poisson process of rate mu it asks for there (vol_track_event). The tracker is
 // a constant at every call site, so each inlined copy holds only its own code (a SIMD back end
@@ -13,7 +13,9 @@
 //    bookkeeping costs more than it saves, +35% on the bundled smoke with lavapipe, so the host
 //    picks the variant from the size of the brick grid: render/path_tracer.cpp);
 //  - VOL_FIELD_MEAN: ReSTIR's per-voxel mean field, an outer DDA over bricks (an empty brick is
-//    one step) and an inner one over the voxels of each occupied brick. Where the fine density
+//    one step) and an inner one over the voxels of each occupied brick, for its optical depth and
+//    residual ratio tracking; a collision in it is sampled by delta tracking against the brick
+//    majorants instead (VOL_TRACK_SAMPLE: no per-voxel walk). Where the fine density
 //    strays far from a voxel's mean (its residual bound times the longest chord the ray can have
 //    through the voxel exceeds VOL_EXACT_TAU optical depths) the field there is the fine
 //    trilinear density itself, integrated exactly ("exact voxels", below): the ReSTIR field is
@@ -177,16 +179,14 @@ const uint VOL_TRACK_DELTA = 0u;     // delta tracking (Woodcock): the first rea
 const uint VOL_TRACK_RATIO = 1u;     // ratio tracking: an unbiased transmittance estimate
 const uint VOL_TRACK_RESIDUAL = 2u;  // residual ratio tracking against the mean field (unbiased)
 const uint VOL_TRACK_TAU = 3u;       // the mean field's optical depth (deterministic)
-const uint VOL_TRACK_SAMPLE = 4u;    // a collision in the mean field, pdf in closed form
+const uint VOL_TRACK_SAMPLE = 4u;    // a collision in the mean field, by delta tracking in it
 const uint VOL_TRACK_DELTA_EMIT = 5u;  // delta tracking that also gathers the medium's emission
 const uint VOL_TRACK_RATIO_EMIT = 6u;  // the emission reaching the origin along a whole ray
 
 struct VolTrack {
-  float value;  // RATIO, RESIDUAL: the transmittance estimate; TAU: the optical depth;
-                // SAMPLE: the optical depth still to go
+  float value;  // RATIO, RESIDUAL: the transmittance estimate; TAU: the optical depth
   float t;      // DELTA, SAMPLE: the collision's distance (tMax without one)
   float sigma;  // SAMPLE: the mean field's sigma_t at the collision
-  float depth;  // SAMPLE: the optical depth crossed (without a collision: over (0, tMax))
   bool hit;     // DELTA, SAMPLE: a collision was found
   bool stop;    // the walk ends now (a hit, a transmittance ended by roulette, the step cap)
 #ifdef PLUME_HAS_EMISSION
@@ -228,7 +228,7 @@ bool vol_track_alive(uint tracker, VolTrack s) {
 // collisions the tracker wants there (0: none).
 float vol_track_segment(uint tracker, inout VolTrack s, float a, float b, vec2 value) {
   if (tracker == VOL_TRACK_DELTA || tracker == VOL_TRACK_RATIO || tracker == VOL_TRACK_DELTA_EMIT ||
-      tracker == VOL_TRACK_RATIO_EMIT) {
+      tracker == VOL_TRACK_RATIO_EMIT || tracker == VOL_TRACK_SAMPLE) {
     return value.x;  // the majorant
   }
   if (tracker == VOL_TRACK_RESIDUAL) {
@@ -236,20 +236,7 @@ float vol_track_segment(uint tracker, inout VolTrack s, float a, float b, vec2 v
     s.value *= exp(-value.x * (b - a));
     return PLUME_RS_RESIDUAL_SCALE * value.y;
   }
-  if (tracker == VOL_TRACK_TAU) {
-    s.value += value.x * (b - a);
-    return 0.0f;
-  }
-  // VOL_TRACK_SAMPLE: every collision of a piecewise-constant field at its own value is real.
-  float dtau = value.x * (b - a);
-  if (value.x > 0.0f && dtau >= s.value) {
-    s.t = a + s.value / value.x;
-    s.sigma = value.x;
-    s.hit = true;
-  } else {
-    s.value -= dtau;
-    s.depth += dtau;
-  }
+  s.value += value.x * (b - a);  // VOL_TRACK_TAU
   return 0.0f;
 }
 
@@ -291,44 +278,39 @@ float vol_exact_integral(VolExact e, float u) {
 }
 
 // vol_track_segment for an exact voxel: TAU adds, RESIDUAL multiplies by the exact transmittance
-// (the residual is 0: no tentative collisions), SAMPLE finds its collision here or passes on.
+// (the residual is 0: no tentative collisions).
 float vol_track_exact(uint tracker, inout VolTrack s, VolWalk w, float scale, float a, float b) {
   VolExact e = vol_exact_start(w, a, b);
-  float len = scale * (b - a);
-  float total = len * vol_exact_integral(e, 1.0f);
+  float total = scale * (b - a) * vol_exact_integral(e, 1.0f);
   if (tracker == VOL_TRACK_RESIDUAL) {
     s.value *= exp(-total);
-  } else if (tracker == VOL_TRACK_TAU) {
-    s.value += total;
-  } else if (total > 0.0f && total >= s.value) {  // VOL_TRACK_SAMPLE: the collision is here
-    float r = s.value / len;  // the density's integral still to go, over u
-    float lo = 0.0f;
-    float hi = 1.0f;
-    float u = clamp(s.value / total, 0.0f, 1.0f);
-    for (int i = 0; i < 40; ++i) {
-      float F = vol_exact_integral(e, u) - r;
-      if (abs(F) <= 1e-6f * r) break;
-      if (F < 0.0f) lo = u; else hi = u;
-      if (hi - lo <= 1e-7f) break;
-      float p = vol_exact_density(e, u);
-      float next = p > 0.0f ? u - F / p : -1.0f;
-      u = (next > lo && next < hi) ? next : 0.5f * (lo + hi);
-    }
-    s.t = a + u * (b - a);
-    s.sigma = scale * vol_exact_density(e, u);
-    s.hit = true;
   } else {
-    s.value -= total;
-    s.depth += total;
+    s.value += total;  // VOL_TRACK_TAU
   }
   return 0.0f;
+}
+
+// The mean field's sigma_t at index-space point p of volume v, for a ray whose voxels are exact
+// above the residual bound exactBound (VolWalk.exactBound): the voxel's mean, or in an exact voxel
+// the fine density there. The brick majorants bound it (media/bake.cpp raises a brick's majorant
+// to its voxels' largest mean where rounding put a mean above it), so delta tracking against
+// them samples this field's collisions (VOL_TRACK_SAMPLE).
+float vol_mean_sigma(uint v, float scale, vec3 p, float exactBound) {
+  ivec3 voxel = ivec3(floor(p));
+  ivec3 brick = voxel >> 3;
+  uint slot = vol_packed_slot(v, brick);
+  if (slot == 0u) return 0.0f;
+  ivec3 sub = voxel - brick * VOL_BRICK;
+  vec2 m = scale * vol_mean_field(v, vol_mean_field_base(v, slot) + uint((sub.z * VOL_BRICK + sub.y) * VOL_BRICK + sub.x));
+  return m.y > exactBound ? scale * vol_density(v, p) : m.x;
 }
 #endif
 
 // At a tentative collision at distance t (index-space point p) of rate mu, in a segment of field
-// value `value`, in volume v of density scale `scale`; u is a uniform number drawn with the step.
+// value `value`, in volume v of density scale `scale`; u is a uniform number drawn with the step;
+// exactBound: the walk's (VolWalk.exactBound, for SAMPLE).
 void vol_track_event(uint tracker, inout VolTrack s, uint v, float scale, vec3 p, float t, float mu, vec2 value,
-                     float u, inout RngState rng) {
+                     float u, float exactBound, inout RngState rng) {
   if (tracker == VOL_TRACK_DELTA) {
     if (u * mu < scale * vol_density(v, p)) {
       s.t = t;
@@ -344,6 +326,17 @@ void vol_track_event(uint tracker, inout VolTrack s, uint v, float scale, vec3 p
   } else if (tracker == VOL_TRACK_RESIDUAL) {
     s.value *= 1.0f - (scale * vol_density(v, p) - value.x) / mu;
   }
+#if defined(PLUME_VOL_MEAN_FIELD) || defined(PLUME_VOL_PREVIOUS)
+  else if (tracker == VOL_TRACK_SAMPLE) {
+    float sigma = vol_mean_sigma(v, scale, p, exactBound);
+    if (u * mu < sigma) {
+      s.t = t;
+      s.sigma = sigma;
+      s.hit = true;
+      s.stop = true;
+    }
+  }
+#endif
 #ifdef PLUME_HAS_EMISSION
   else if (tracker == VOL_TRACK_DELTA_EMIT) {
     // Every tentative collision, the one that turns out real included, adds sigma_t Le / mu: a
@@ -443,7 +436,7 @@ void vol_track_by_collision(uint tracker, uint v, inout VolTrack s, inout VolWal
 #ifdef PLUME_KERNEL_COUNTERS
     vol_kc_lookup(kc);
 #endif
-    vol_track_event(tracker, s, v, scale, o + t * d, t, mu, value, rng_to_float(h.y), rng);
+    vol_track_event(tracker, s, v, scale, o + t * d, t, mu, value, rng_to_float(h.y), w.exactBound, rng);
     if (s.stop) break;
   }
 }
@@ -499,7 +492,7 @@ bool vol_mean_next_voxel(inout VolWalk w, out float a, out float b, out vec2 val
   return true;
 }
 
-// The closed-form trackers (TAU, SAMPLE: no draws).
+// The closed-form tracker (TAU: no draws).
 void vol_track_mean_closed(uint tracker, inout VolTrack s, inout VolWalk w, float scale VOL_KC_PARAM) {
   bool innerLive = false;
   bool pending = false;  // an exact voxel [a, b) waits for the outer loop
@@ -557,7 +550,7 @@ void vol_track_mean_residual(uint tracker, uint v, inout VolTrack s, inout VolWa
 #ifdef PLUME_KERNEL_COUNTERS
       vol_kc_lookup(kc);
 #endif
-      vol_track_event(tracker, s, v, scale, o + t * d, t, mu, value, rng_to_float(h.y), rng);
+      vol_track_event(tracker, s, v, scale, o + t * d, t, mu, value, rng_to_float(h.y), w.exactBound, rng);
       if (s.stop) break;
       draw = true;
     }
@@ -602,8 +595,7 @@ void vol_track_mean_residual(uint tracker, uint v, inout VolTrack s, inout VolWa
   }
 }
 #endif
-// The walk. `init`: the tracker's starting value (RATIO, RESIDUAL 1; TAU 0; SAMPLE the optical
-// depth to the collision). Each tentative collision of the majorant's (or the residual's) Poisson
+// The walk. `init`: the tracker's starting value (RATIO, RESIDUAL 1; TAU 0; DELTA, SAMPLE unused). Each tentative collision of the majorant's (or the residual's) Poisson
 // process draws one rng_next4: its x the optical depth Exp(1) to it from the last one, spent
 // across segments of different rates (the inverse of the piecewise-linear optical depth), its y
 // the event's u.
@@ -612,13 +604,12 @@ VolTrack vol_track(uint tracker, uint v, vec3 xWorld, vec3 wWorld, float tMax, f
   s.value = init;
   s.t = tMax;
   s.sigma = 0.0f;
-  s.depth = 0.0f;
   s.hit = false;
   s.stop = false;
 #ifdef PLUME_HAS_EMISSION
   s.emitted = vec3(0.0f);
 #endif
-  uint field = (tracker <= VOL_TRACK_RATIO || tracker >= VOL_TRACK_DELTA_EMIT) ? VOL_FIELD_MAJORANT : VOL_FIELD_MEAN;
+  uint field = (tracker == VOL_TRACK_RESIDUAL || tracker == VOL_TRACK_TAU) ? VOL_FIELD_MEAN : VOL_FIELD_MAJORANT;
   vec3 o;
   vec3 d;
   vol_ray_to_index(v, xWorld, wWorld, o, d);
@@ -741,20 +732,18 @@ float vol_mean_tr(uint v, vec3 xWorld, vec3 wWorld, float tMax) {
   return exp(-min(vol_mean_tau(v, xWorld, wWorld, tMax), VOL_MAX_TAU));
 }
 
-// Tracking in the current volume's mean field: in a piecewise-constant medium the majorant
-// equals the density, so every tentative collision is real and the free-flight pdf is
-// sigmaC * exp(-tau) in closed form. False (probability exp(-tau_c(0, tMax))) when the ray
-// leaves first. tau, the optical depth to the collision, is also the target's transmittance of
-// the segment, so a candidate marches each segment once (tau <= -log(2^-24) ~ 16.6: the pdf
-// never underflows). Without a collision tau is the optical depth over (0, tMax), the one
-// vol_mean_tau would march again (the same segments summed in the same order).
-bool vol_mean_sample(vec3 xWorld, vec3 wWorld, float tMax, float u, out float t, out float sigmaC, out float tau) {
-  tau = -log(1.0f - u);
-  RngState unused = RngState(uvec4(0u), 0u);  // never drawn from: SAMPLE is closed form
-  VolTrack s = vol_track(VOL_TRACK_SAMPLE, VOL_CURRENT, xWorld, wWorld, tMax, tau, unused);
+// A collision in the current volume's mean field (vol_mean_sigma) by delta tracking against the
+// brick majorants: its distance t has the free-flight pdf sigmaC exp(-tau_c(0, t)), sigmaC the
+// field at the collision (returned), and there is none (false) with probability
+// exp(-tau_c(0, tMax)). The optical depth tau_c itself is not known here, and ReSTIR's candidates
+// need none: the target's transmittance of the segment is the same exp(-tau_c) (vol_mean_tr), so
+// it cancels in a candidate's weight f / p, which keeps sigma / sigmaC (restir/candidates.glsl).
+// Against walking the field voxel by voxel in closed form (until session 27), a few tentative
+// collisions a brick instead of every voxel crossed (notes/bench/kernels.md "Session 27").
+bool vol_mean_sample(vec3 xWorld, vec3 wWorld, float tMax, inout RngState rng, out float t, out float sigmaC) {
+  VolTrack s = vol_track(VOL_TRACK_SAMPLE, VOL_CURRENT, xWorld, wWorld, tMax, 0.0f, rng);
   t = s.t;
   sigmaC = s.sigma;
-  if (!s.hit) tau = s.depth;
   return s.hit;
 }
 

@@ -74,7 +74,7 @@ double msSince(std::chrono::steady_clock::time_point t0) {
 const char* kTrackerNames[sh::KC_TRACKERS] = {"delta tracking",   "ratio tracking (NEE)", "residual ratio tracking",
                                               "mean-field depth", "mean-field sampling",  "delta tracking + emission",
                                               "ratio tracking + emission"};
-bool isTracking(uint32_t t) { return t == 0 || t == 5; }           // free flights
+bool isTracking(uint32_t t) { return t == 0 || t == 4 || t == 5; }  // free flights (4: in the mean field)
 bool isTransmittance(uint32_t t) { return t == 1 || t == 2 || t == 6; }  // transmittance estimates
 
 double ratio(double a, double b) { return b > 0 ? a / b : 0; }

@@ -196,8 +196,9 @@ SlotResult writeTexels(BakedVolume& vol, uint32_t slot, const Window& w) {
   return r;
 }
 
-// ReSTIR's mean field of one brick (bake.h voxelMean, voxelResidual).
-void writeMeanField(BakedVolume& vol, uint32_t slot, const Window& w) {
+// ReSTIR's mean field of one brick (bake.h voxelMean, voxelResidual); returns its largest mean.
+float writeMeanField(BakedVolume& vol, uint32_t slot, const Window& w) {
+  float largest = 0.0f;
   float* vm = &vol.voxelMean[size_t(slot) * 512];
   float* vr = &vol.voxelResidual[size_t(slot) * 512];
   for (int z = 0; z < 8; ++z)
@@ -214,7 +215,9 @@ void writeMeanField(BakedVolume& vol, uint32_t slot, const Window& w) {
         for (double c : corner) dev = std::max(dev, std::abs(c - mean) + std::abs(c) * 0x1p-10);
         vm[(z * 8 + y) * 8 + x] = mean;
         vr[(z * 8 + y) * 8 + x] = halfAtLeast(dev);
+        largest = std::max(largest, mean);
       }
+  return largest;
 }
 
 // --- Layout -------------------------------------------------------------------------------------
@@ -318,10 +321,13 @@ void fillBricks(BakedVolume& vol, const openvdb::FloatGrid& grid, const BrickBox
       const auto [b, s] = slots[i];
       gatherWindow(acc, box.origin + delinearize(b, box.dims), w);
       const SlotResult res = writeTexels(vol, s, w);
-      brickMajorant[b] = res.majorant * kMajorantMargin;
+      // The majorant bounds the mean field too, whose sampling tracks against it (volume/walk.glsl
+      // vol_mean_sigma): a mean rounded to half precision may exceed its corners' largest texel
+      // by up to 2^-11 of it, and a tiny one is raised to the smallest normal half.
+      const float meanMax = opt.meanField ? writeMeanField(vol, s, w) : 0.0f;
+      brickMajorant[b] = std::max(res.majorant, meanMax) * kMajorantMargin;
       mine.maxAbsError = std::max(mine.maxAbsError, res.maxAbsError);
       mine.maxValue = std::max(mine.maxValue, res.maxValue);
-      if (opt.meanField) writeMeanField(vol, s, w);
     }
   });
   worst.combine_each([&](const SlotResult& r) {
