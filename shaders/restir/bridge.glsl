@@ -133,12 +133,6 @@ vec3 rs_emitter_hit(float pdfDir, uint prim, vec3 o, vec3 w, float t) {
 }
 #endif
 
-// Transmittance: the mean field's deterministic one (target) or residual ratio tracking on the
-// fine grid of the current volume against the same field (unbiased; final shading only, v = 0).
-float rs_transmittance(uint v, vec3 x, vec3 w, float dist, bool unbiased, inout RngState rng) {
-  return unbiased ? vol_residual_tr(x, w, dist, rng) : vol_mean_tr(v, x, w, dist);
-}
-
 // The connection from the path's last vertex vx to a light sample: where the light ray starts
 // (o, pushed off a surface), its direction w and length `reach` (DDA_INF for distant lights; for
 // a point on an emissive triangle, short of the triangle itself), and the unshadowed light term
@@ -186,19 +180,30 @@ bool rs_light_connect(PathVertex vx, uint light, vec2 ls, uint prim, bool withMi
   return true;
 }
 
+// The light ray from vx to a light sample (rs_light_connect, with its MIS weight), and with
+// surfaces its visibility; false where the light term is 0.
+bool rs_light_ray(PathVertex vx, uint light, vec2 ls, uint prim, out RsLightRay c) {
+  if (!rs_light_connect(vx, light, ls, prim, true, c)) return false;
+#ifdef PLUME_HAS_SURFACES
+  if (surf_occluded(c.o, c.w, c.reach)) return false;
+#endif
+  return true;
+}
+
+// The target's transmittance along a light ray: the mean field's depth by the midpoint rule
+// (vol_mean_tau_midpoints: far cheaper than the voxel walk of the path's own segments).
+float rs_target_light_tr(uint v, RsLightRay c) {
+  return exp(-min(vol_mean_tau_midpoints(v, c.o, c.w, c.reach), VOL_MAX_TAU));
+}
+
 // The light term at the path's last vertex vx: the connection's unshadowed term times the
-// transmittance along the light ray (and, with surfaces, its visibility). The target's light ray
-// takes the mean field's depth by the midpoint rule (vol_mean_tau_midpoints: far cheaper than the
-// voxel walk of the path's own segments, which the candidates' sampling needs exactly); final
-// shading's is unbiased (rs_transmittance).
+// transmittance along the light ray (and, with surfaces, its visibility): the target's
+// (rs_target_light_tr) or an unbiased one (residual ratio tracking on the fine grid of the current
+// volume against the mean field, v = 0: the tail's light rays).
 vec3 rs_light_term(uint v, PathVertex vx, uint light, vec2 ls, uint prim, bool unbiased, inout RngState rng) {
   RsLightRay c;
-  if (!rs_light_connect(vx, light, ls, prim, true, c)) return vec3(0.0f);
-#ifdef PLUME_HAS_SURFACES
-  if (surf_occluded(c.o, c.w, c.reach)) return vec3(0.0f);
-#endif
-  float tr = unbiased ? rs_transmittance(v, c.o, c.w, c.reach, true, rng)
-                      : exp(-min(vol_mean_tau_midpoints(v, c.o, c.w, c.reach), VOL_MAX_TAU));
+  if (!rs_light_ray(vx, light, ls, prim, c)) return vec3(0.0f);
+  float tr = unbiased ? vol_residual_tr(c.o, c.w, c.reach, rng) : rs_target_light_tr(v, c);
   return c.value * tr;
 }
 
@@ -341,7 +346,16 @@ float rs_reconnect_area_factor(uint prim, vec3 w, float d) { return abs(dot(surf
 // path ending in emission has sigma_a(x_n) Le(x_n) in place of sigma_s(x_n) and the light term.
 // With the reconnection shift vertex r = rs_reconnect_vertex is the stored point x_r instead:
 // o_{r-1} is connected to it (f = 0 where a surface lies between) and f carries its area factor.
-vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool unbiased, inout RngState rng) {
+//
+// shading false: the target's f (every transmittance the mean field's, est = 1). shading true
+// (final shading, D the current frame's domain): f without the path's segment transmittances,
+// and est an unbiased estimate of the ratio of the fine transmittances to the target's, so that
+// f * (product of the segments' exp(-tau_c)) * est is unbiased for the path's contribution. The
+// product is the target's own factor: p̂ / lum(f) (restir/shade.glsl), so no segment walks the
+// mean field here; each takes vol_residual_ratio, and the light ray residual ratio tracking
+// over the target's midpoint-rule transmittance.
+vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool shading, inout RngState rng, out float est) {
+  est = 1.0f;
   RsPathHead h = rs_load_head(set, pixelIndex);
   uint n = h.vertexCount;
   if (n == 0u) return vec3(0.0f);
@@ -412,7 +426,12 @@ vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool unbiased, 
       return vec3(0.0f);
     }
 #endif
-    float tr = rs_transmittance(D.v, x, w, t, unbiased, rng);
+    float tr = 1.0f;
+    if (shading) {
+      est *= vol_residual_ratio(x, w, t, rng);
+    } else {
+      tr = vol_mean_tr(D.v, x, w, t);
+    }
 #ifdef PLUME_RS_RECONNECT
     if (rc) tr *= rs_reconnect_area_factor(hit.prim, w, t);
 #endif
@@ -444,13 +463,18 @@ vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool unbiased, 
 #ifndef PLUME_HAS_SURFACES
   vx = vtx_medium(x, w);
 #endif
-  return f * rs_light_term(D.v, vx, h.light, h.lightSample, h.lightPrim, unbiased, rng);
+  RsLightRay c;
+  if (!rs_light_ray(vx, h.light, h.lightSample, h.lightPrim, c)) return vec3(0.0f);
+  float trTarget = rs_target_light_tr(D.v, c);
+  if (shading) est *= vol_residual_tr(c.o, c.w, c.reach, rng) / trTarget;
+  return f * c.value * trTarget;
 }
 
 // The target function p̂_D(y): deterministic (no random numbers are drawn on this path).
 float rs_target(RsDomain D, uint set, uint pixelIndex) {
   RngState unused = RngState(uvec4(0u), 0u);  // never drawn from: no hash to pay for
-  return rs_luminance(rs_path_contribution(D, set, pixelIndex, false, unused));
+  float est;
+  return rs_luminance(rs_path_contribution(D, set, pixelIndex, false, unused, est));
 }
 
 #endif

@@ -13,7 +13,7 @@
 // and only "vertex j of some walk, light l" can produce it, so the M walks give it the MIS
 // weight 1/M (GRIS allows candidates of one walk to be dependent: only marginals matter). The
 // target's transmittance of each segment, exp(-tau_c) of the same mean field (restir/bridge.glsl
-// rs_transmittance), is the source pdf's too, so the walks carry neither and a candidate's weight
+// rs_path_contribution), is the source pdf's too, so the walks carry neither and a candidate's weight
 // p̂ / p needs no optical depth (the target clamps tau_c at VOL_MAX_TAU = 80, where the two part:
 // a path beyond it is sampled with probability below e^-80); the reservoir's p̂ of the selected
 // path, which reuse needs, is the target evaluated once on the stored path (rs_target). With an

@@ -1,6 +1,7 @@
 // Final shading (DESIGN §4.2 step 7): the selected path evaluated once with unbiased
-// transmittance (residual ratio tracking on the fine grid, every segment and the light ray) times
-// W = w_sum / p̂(Y); plus the radiance of the camera ray escaping the scene (light_escaped, also
+// transmittance times W = w_sum / p̂(Y): residual ratio tracking against the mean field, whose
+// transmittances of the path's segments are p̂'s own factors (so only the ratio of the fine ones to
+// them is estimated, bridge.glsl rs_path_contribution), and of the light ray; plus the radiance of the camera ray escaping the scene (light_escaped, also
 // by residual ratio tracking) and the medium's emission seen directly, which no reservoir path
 // covers; with emissive surfaces, the lamps seen directly from their reservoir of their own; plus,
 // when max_bounces exceeds the prefix K that reservoirs hold (or, in an emitting medium,
@@ -134,7 +135,15 @@ bool rs_tail_advance(inout RsTail s, inout RngState rng) {
 vec3 rs_shade(RsDomain D, uint pixelIndex, uint set, inout RngState rng) {
   RsReservoir r = rs_load(set, pixelIndex);
   vec3 L = vec3(0.0f);
-  if (r.W > 0.0f) L += r.W * rs_path_contribution(D, set, pixelIndex, true, rng);
+  if (r.W > 0.0f) {
+    // f without the segments' transmittances, whose target product is p̂ / lum(f) (the
+    // reservoir's p̂ is the target of its path in this domain: candidates.glsl, reuse.glsl), and
+    // the estimate of the fine transmittances' ratio to the target's (bridge.glsl).
+    float est;
+    vec3 f = rs_path_contribution(D, set, pixelIndex, true, rng, est);
+    float lum = rs_luminance(f);
+    if (lum > 0.0f) L += (r.W * r.p_hat / lum) * est * f;
+  }
 #ifdef PLUME_HAS_EMITTERS
   // The lamps seen directly: their reservoir's sample (restir/candidates.glsl rs_lamp_reservoir),
   // W Le T along its ray, T by residual ratio tracking.

@@ -18,7 +18,7 @@
 PLUME_NS_BEGIN
 
 const uint KC_BASE = 4u;          // volCounters[0..3]: the volume's own (step-cap truncations)
-const uint KC_TRACKERS = 7u;      // VOL_TRACK_DELTA .. VOL_TRACK_RATIO_EMIT
+const uint KC_TRACKERS = 8u;      // VOL_TRACK_DELTA .. VOL_TRACK_RESIDUAL_RATIO
 const uint KC_PER_TRACKER = 8u;
 const uint KC_WALKS = 0u;
 const uint KC_SEGMENTS = 1u;

@@ -182,9 +182,11 @@ const uint VOL_TRACK_TAU = 3u;       // the mean field's optical depth (determin
 const uint VOL_TRACK_SAMPLE = 4u;    // a collision in the mean field, by delta tracking in it
 const uint VOL_TRACK_DELTA_EMIT = 5u;  // delta tracking that also gathers the medium's emission
 const uint VOL_TRACK_RATIO_EMIT = 6u;  // the emission reaching the origin along a whole ray
+const uint VOL_TRACK_RESIDUAL_RATIO = 7u;  // T_fine / T_mean by residual ratio tracking (unbiased)
 
 struct VolTrack {
-  float value;  // RATIO, RESIDUAL: the transmittance estimate; TAU: the optical depth
+  float value;  // RATIO, RESIDUAL: the transmittance estimate; RESIDUAL_RATIO: that of its ratio
+                // to the mean field's; TAU: the optical depth
   float t;      // DELTA, SAMPLE: the collision's distance (tMax without one)
   float sigma;  // SAMPLE: the mean field's sigma_t at the collision
   bool hit;     // DELTA, SAMPLE: a collision was found
@@ -219,7 +221,7 @@ bool vol_transmittance_roulette(inout float tr, inout RngState rng) {
 bool vol_track_alive(uint tracker, VolTrack s) {
   if (s.stop) return false;
   if (tracker == VOL_TRACK_RATIO || tracker == VOL_TRACK_RATIO_EMIT) return s.value > 0.0f;
-  if (tracker == VOL_TRACK_RESIDUAL) return s.value != 0.0f;
+  if (tracker == VOL_TRACK_RESIDUAL || tracker == VOL_TRACK_RESIDUAL_RATIO) return s.value != 0.0f;
   if (tracker == VOL_TRACK_TAU) return s.value < VOL_MAX_TAU;
   return !s.hit;
 }
@@ -228,7 +230,7 @@ bool vol_track_alive(uint tracker, VolTrack s) {
 // collisions the tracker wants there (0: none).
 float vol_track_segment(uint tracker, inout VolTrack s, float a, float b, vec2 value) {
   if (tracker == VOL_TRACK_DELTA || tracker == VOL_TRACK_RATIO || tracker == VOL_TRACK_DELTA_EMIT ||
-      tracker == VOL_TRACK_RATIO_EMIT || tracker == VOL_TRACK_SAMPLE) {
+      tracker == VOL_TRACK_RATIO_EMIT || tracker == VOL_TRACK_SAMPLE || tracker == VOL_TRACK_RESIDUAL_RATIO) {
     return value.x;  // the majorant
   }
   if (tracker == VOL_TRACK_RESIDUAL) {
@@ -335,6 +337,9 @@ void vol_track_event(uint tracker, inout VolTrack s, uint v, float scale, vec3 p
       s.hit = true;
       s.stop = true;
     }
+  } else if (tracker == VOL_TRACK_RESIDUAL_RATIO) {
+    // The fine density and the mean field both lie in [0, mu]: the factor in [0, 2].
+    s.value *= 1.0f - (scale * vol_density(v, p) - vol_mean_sigma(v, scale, p, exactBound)) / mu;
   }
 #endif
 #ifdef PLUME_HAS_EMISSION
@@ -756,6 +761,17 @@ bool vol_mean_sample(vec3 xWorld, vec3 wWorld, float tMax, inout RngState rng, o
 // residual's optical depth instead of the density's.
 float vol_residual_tr(vec3 xWorld, vec3 wWorld, float tMax, inout RngState rng) {
   return vol_track(VOL_TRACK_RESIDUAL, VOL_CURRENT, xWorld, wWorld, tMax, 1.0f, rng).value;
+}
+
+// An unbiased estimate of the ratio T / exp(-tau_c) of the current volume's fine transmittance
+// over (0, tMax) to its mean field's (vol_mean_sigma), without walking the mean field: residual
+// ratio tracking's product alone, prod_i (1 - (sigma(x_i) - sigma_c(x_i)) / mu) over a Poisson
+// process of the brick majorants' rate mu, whose expectation is exp(-int (sigma - sigma_c)). Where
+// a caller knows exp(-tau_c) already (final shading: it is part of the reservoir's p̂,
+// restir/shade.glsl), this is all the unbiased transmittance needs: a few tentative collisions a
+// brick instead of every voxel crossed. Relative variance exp(int (sigma - sigma_c)² / mu) - 1.
+float vol_residual_ratio(vec3 xWorld, vec3 wWorld, float tMax, inout RngState rng) {
+  return vol_track(VOL_TRACK_RESIDUAL_RATIO, VOL_CURRENT, xWorld, wWorld, tMax, 1.0f, rng).value;
 }
 #endif
 

@@ -73,9 +73,9 @@ double msSince(std::chrono::steady_clock::time_point t0) {
 // The walk's trackers (VOL_TRACK_* of shaders/volume/walk.glsl), by counter block.
 const char* kTrackerNames[sh::KC_TRACKERS] = {"delta tracking",   "ratio tracking (NEE)", "residual ratio tracking",
                                               "mean-field depth", "mean-field sampling",  "delta tracking + emission",
-                                              "ratio tracking + emission"};
+                                              "ratio tracking + emission", "residual ratio, segments"};
 bool isTracking(uint32_t t) { return t == 0 || t == 4 || t == 5; }  // free flights (4: in the mean field)
-bool isTransmittance(uint32_t t) { return t == 1 || t == 2 || t == 6; }  // transmittance estimates
+bool isTransmittance(uint32_t t) { return t == 1 || t == 2 || t == 6 || t == 7; }  // transmittance estimates
 
 double ratio(double a, double b) { return b > 0 ? a / b : 0; }
 
