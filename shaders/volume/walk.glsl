@@ -216,6 +216,15 @@ bool vol_transmittance_roulette(inout float tr, inout RngState rng) {
 #ifndef PLUME_RS_RESIDUAL_SCALE
 #define PLUME_RS_RESIDUAL_SCALE 1.0f
 #endif
+// vol_residual_ratio's rate, in brick majorants: relative variance exp(int r² / (scale mu)) - 1
+// for the residual r, at scale times the tentative collisions. Final shading's transmittances are
+// a large part of ReSTIR's error: on the bundled smoke (128², `plume bench`, seeds 1-3) scale 1
+// raised ReSTIR's relMSE ~30% over the per-voxel walk it replaced, 4 by 0-7% (shading ~1.5 ms a
+// frame faster of 24: equal-time gains equal or better), 8 matched it at the walk's cost
+// (notes/restir.md "Session 27").
+#ifndef PLUME_RS_RATIO_SCALE
+#define PLUME_RS_RATIO_SCALE 4.0f
+#endif
 
 // Whether the walk goes on to the next segment.
 bool vol_track_alive(uint tracker, VolTrack s) {
@@ -230,9 +239,10 @@ bool vol_track_alive(uint tracker, VolTrack s) {
 // collisions the tracker wants there (0: none).
 float vol_track_segment(uint tracker, inout VolTrack s, float a, float b, vec2 value) {
   if (tracker == VOL_TRACK_DELTA || tracker == VOL_TRACK_RATIO || tracker == VOL_TRACK_DELTA_EMIT ||
-      tracker == VOL_TRACK_RATIO_EMIT || tracker == VOL_TRACK_SAMPLE || tracker == VOL_TRACK_RESIDUAL_RATIO) {
+      tracker == VOL_TRACK_RATIO_EMIT || tracker == VOL_TRACK_SAMPLE) {
     return value.x;  // the majorant
   }
+  if (tracker == VOL_TRACK_RESIDUAL_RATIO) return PLUME_RS_RATIO_SCALE * value.x;
   if (tracker == VOL_TRACK_RESIDUAL) {
     // The control's transmittance in closed form, the residual by ratio tracking at mu.
     s.value *= exp(-value.x * (b - a));
