@@ -776,7 +776,7 @@ float vol_residual_tr(vec3 xWorld, vec3 wWorld, float tMax, inout RngState rng) 
 // An unbiased estimate of the ratio T / exp(-tau_c) of the current volume's fine transmittance
 // over (0, tMax) to its mean field's (vol_mean_sigma), without walking the mean field: residual
 // ratio tracking's product alone, prod_i (1 - (sigma(x_i) - sigma_c(x_i)) / mu) over a Poisson
-// process of the brick majorants' rate mu, whose expectation is exp(-int (sigma - sigma_c)). Where
+// process of rate mu = PLUME_RS_RATIO_SCALE brick majorants, whose expectation is exp(-int (sigma - sigma_c)). Where
 // a caller knows exp(-tau_c) already (final shading: it is part of the reservoir's p̂,
 // restir/shade.glsl), this is all the unbiased transmittance needs: a few tentative collisions a
 // brick instead of every voxel crossed. Relative variance exp(int (sigma - sigma_c)² / mu) - 1.
