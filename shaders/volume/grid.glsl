@@ -84,11 +84,8 @@ float vol_filtered(uint v, ivec3 t, vec3 f) { return vol_filter(volAtlas, t, f);
 #endif
 #endif
 
-// Density d at an index-space point (not yet multiplied by the density scale).
-float vol_density(uint v, vec3 p) {
-  ivec3 t;
-  vec3 f;
-  if (!vol_locate(v, p, t, f)) return 0.0f;
+// The trilinear density of volume v's voxel whose first corner is atlas texel t, at fractions f.
+float vol_density_at(uint v, ivec3 t, vec3 f) {
 #ifdef PLUME_HW_FILTER
   return vol_filtered(v, t, f);
 #else
@@ -96,6 +93,14 @@ float vol_density(uint v, vec3 p) {
   for (int c = 0; c < 8; ++c) sum += vol_corner_weight(c, f) * vol_texel(v, t + ivec3(c & 1, (c >> 1) & 1, (c >> 2) & 1));
   return sum;
 #endif
+}
+
+// Density d at an index-space point (not yet multiplied by the density scale).
+float vol_density(uint v, vec3 p) {
+  ivec3 t;
+  vec3 f;
+  if (!vol_locate(v, p, t, f)) return 0.0f;
+  return vol_density_at(v, t, f);
 }
 
 #ifdef PLUME_HAS_EMISSION

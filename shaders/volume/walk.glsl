@@ -302,19 +302,23 @@ float vol_track_exact(uint tracker, inout VolTrack s, VolWalk w, float scale, fl
   return 0.0f;
 }
 
-// The mean field's sigma_t at index-space point p of volume v, for a ray whose voxels are exact
-// above the residual bound exactBound (VolWalk.exactBound): the voxel's mean, or in an exact voxel
-// the fine density there. The brick majorants bound it (media/bake.cpp raises a brick's majorant
-// to its voxels' largest mean where rounding put a mean above it), so delta tracking against
-// them samples this field's collisions (VOL_TRACK_SAMPLE).
-float vol_mean_sigma(uint v, float scale, vec3 p, float exactBound) {
-  ivec3 voxel = ivec3(floor(p));
+// sigma_t at index-space point p of volume v: the fine density's (x) and the mean field's (y), for
+// a ray whose voxels are exact above the residual bound exactBound (VolWalk.exactBound): the
+// voxel's mean, or in an exact voxel the fine density. One indirection read serves both (a SIMD
+// back end such as lavapipe reads the fine density for every lane anyway: both sides of the
+// exact voxel's select run). The brick majorants bound both (media/bake.cpp raises a brick's
+// majorant to its voxels' largest mean where rounding put a mean above it), so delta tracking
+// against them samples the mean field's collisions (VOL_TRACK_SAMPLE).
+vec2 vol_fine_and_mean(uint v, float scale, vec3 p, float exactBound) {
+  vec3 fl = floor(p);
+  ivec3 voxel = ivec3(fl);
   ivec3 brick = voxel >> 3;
   uint slot = vol_packed_slot(v, brick);
-  if (slot == 0u) return 0.0f;
+  if (slot == 0u) return vec2(0.0f);
   ivec3 sub = voxel - brick * VOL_BRICK;
+  float fine = scale * vol_density_at(v, vol_slot_coords(slot) * VOL_TEXELS + sub + 1, p - fl);  // as vol_locate
   vec2 m = scale * vol_mean_field(v, vol_mean_field_base(v, slot) + uint((sub.z * VOL_BRICK + sub.y) * VOL_BRICK + sub.x));
-  return m.y > exactBound ? scale * vol_density(v, p) : m.x;
+  return vec2(fine, m.y > exactBound ? fine : m.x);
 }
 #endif
 
@@ -340,7 +344,7 @@ void vol_track_event(uint tracker, inout VolTrack s, uint v, float scale, vec3 p
   }
 #if defined(PLUME_VOL_MEAN_FIELD) || defined(PLUME_VOL_PREVIOUS)
   else if (tracker == VOL_TRACK_SAMPLE) {
-    float sigma = vol_mean_sigma(v, scale, p, exactBound);
+    float sigma = vol_fine_and_mean(v, scale, p, exactBound).y;
     if (u * mu < sigma) {
       s.t = t;
       s.sigma = sigma;
@@ -349,7 +353,8 @@ void vol_track_event(uint tracker, inout VolTrack s, uint v, float scale, vec3 p
     }
   } else if (tracker == VOL_TRACK_RESIDUAL_RATIO) {
     // The fine density and the mean field both lie in [0, mu]: the factor in [0, 2].
-    s.value *= 1.0f - (scale * vol_density(v, p) - vol_mean_sigma(v, scale, p, exactBound)) / mu;
+    vec2 sigma = vol_fine_and_mean(v, scale, p, exactBound);
+    s.value *= 1.0f - (sigma.x - sigma.y) / mu;
   }
 #endif
 #ifdef PLUME_HAS_EMISSION
@@ -747,7 +752,7 @@ float vol_mean_tr(uint v, vec3 xWorld, vec3 wWorld, float tMax) {
   return exp(-min(vol_mean_tau(v, xWorld, wWorld, tMax), VOL_MAX_TAU));
 }
 
-// A collision in the current volume's mean field (vol_mean_sigma) by delta tracking against the
+// A collision in the current volume's mean field (vol_fine_and_mean) by delta tracking against the
 // brick majorants: its distance t has the free-flight pdf sigmaC exp(-tau_c(0, t)), sigmaC the
 // field at the collision (returned), and there is none (false) with probability
 // exp(-tau_c(0, tMax)). The optical depth tau_c itself is not known here, and ReSTIR's candidates
@@ -774,7 +779,7 @@ float vol_residual_tr(vec3 xWorld, vec3 wWorld, float tMax, inout RngState rng) 
 }
 
 // An unbiased estimate of the ratio T / exp(-tau_c) of the current volume's fine transmittance
-// over (0, tMax) to its mean field's (vol_mean_sigma), without walking the mean field: residual
+// over (0, tMax) to its mean field's (vol_fine_and_mean), without walking the mean field: residual
 // ratio tracking's product alone, prod_i (1 - (sigma(x_i) - sigma_c(x_i)) / mu) over a Poisson
 // process of rate mu = PLUME_RS_RATIO_SCALE brick majorants, whose expectation is exp(-int (sigma - sigma_c)). Where
 // a caller knows exp(-tau_c) already (final shading: it is part of the reservoir's p̂,

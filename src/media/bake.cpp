@@ -322,7 +322,7 @@ void fillBricks(BakedVolume& vol, const openvdb::FloatGrid& grid, const BrickBox
       gatherWindow(acc, box.origin + delinearize(b, box.dims), w);
       const SlotResult res = writeTexels(vol, s, w);
       // The majorant bounds the mean field too, whose sampling tracks against it (volume/walk.glsl
-      // vol_mean_sigma): a mean rounded to half precision may exceed its corners' largest texel
+      // vol_fine_and_mean): a mean rounded to half precision may exceed its corners' largest texel
       // by up to 2^-11 of it, and a tiny one is raised to the smallest normal half.
       const float meanMax = opt.meanField ? writeMeanField(vol, s, w) : 0.0f;
       brickMajorant[b] = std::max(res.majorant, meanMax) * kMajorantMargin;

@@ -183,10 +183,12 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   // taken still runs under a mask (measured: -20 to -40% per reuse pass).
   auto make = [&](const char* file, const char* name, gpu::ShaderDefines extra) {
     gpu::ShaderDefines d = defines;
-    // Final shading estimates f / p̂ per segment by residual ratio tracking against the target's
-    // mean field (volume/walk.glsl) at 16x the residual majorant: on the bundled smoke (64²,
-    // temporal reuse) relMSE 0.011 at 1x, 0.0082 at 2x, 0.0054 at 8x, 0.0046 at 16x, 0.0046 at
-    // 32x, shading 3.4 -> 5.9 ms; 16x is where the error stops falling (notes/restir.md).
+    // Final shading's unbiased transmittances of light rays, escaping camera rays and the tail's
+    // light rays: residual ratio tracking against the mean field (volume/walk.glsl) at 16x the
+    // residual majorant: on the bundled smoke (64², temporal reuse, when every path segment took
+    // it too) relMSE 0.011 at 1x, 0.0082 at 2x, 0.0054 at 8x, 0.0046 at 16x, 0.0046 at 32x,
+    // shading 3.4 -> 5.9 ms; 16x is where the error stops falling (notes/restir.md). The path's
+    // segments take vol_residual_ratio at PLUME_RS_RATIO_SCALE brick majorants (session 27).
     d.emplace_back("PLUME_RS_RESIDUAL_SCALE", "16.0f");
     d.emplace_back("PLUME_RS_MIS", std::to_string(options_.mis) + "u");
     d.emplace_back("PLUME_RS_LIGHT_CANDIDATES", std::to_string(lightCandidates));
