@@ -1,11 +1,11 @@
 // Candidate paths (DESIGN §4.2 step 1). M random walks per pixel, each from its own uniform
 // position (u, v) in the pixel: each vertex's distance comes from delta tracking in the mean
-// field against the brick majorants (pdf sigma_c exp(-tau_c); volume/walk.glsl vol_mean_sample), each further
-// direction from the vertex's scattering (HG), and every vertex ends one candidate with a light
-// sample: a light chosen in proportion to its estimated power (render/restir.cpp lightChoice),
-// or, with PLUME_RS_LIGHT_CANDIDATES = L > 1 (render.restir_light_candidates), the survivor of L
-// such samples resampled by their unshadowed term (bridge.glsl rs_resample_light), whose RIS
-// weight W_light stands for 1 / p_light below. The candidate ending at vertex j of walk m
+// field against the brick majorants (pdf sigma_c exp(-tau_c); volume/walk.glsl vol_mean_sample),
+// each further direction from the vertex's scattering (HG), and every vertex ends one candidate
+// with a light sample: a light chosen in proportion to its estimated power (render/restir.cpp
+// lightChoice), or, with PLUME_RS_LIGHT_CANDIDATES = L > 1 (render.restir_light_candidates), the
+// survivor of L such samples resampled by their unshadowed term (bridge.glsl rs_resample_light),
+// whose RIS weight W_light stands for 1 / p_light below. The candidate ending at vertex j of walk m
 // with light l is the path
 // (u, v, t1, w2, t2, ..., w_j, t_j, l, light sample) with source pdf
 //   p(y) = prod_i sigma_c(x_i) exp(-tau_i) * prod_{i>=2} phase_i * prod q (Russian roulette)
@@ -13,11 +13,11 @@
 // and only "vertex j of some walk, light l" can produce it, so the M walks give it the MIS
 // weight 1/M (GRIS allows candidates of one walk to be dependent: only marginals matter). The
 // target's transmittance of each segment, exp(-tau_c) of the same mean field (restir/bridge.glsl
-// rs_path_contribution), is the source pdf's too, so the walks carry neither and a candidate's weight
-// p̂ / p needs no optical depth (the target clamps tau_c at VOL_MAX_TAU = 80, where the two part:
-// a path beyond it is sampled with probability below e^-80); the reservoir's p̂ of the selected
-// path, which reuse needs, is the target evaluated once on the stored path (rs_target). With an
-// emitting medium (PLUME_HAS_EMISSION) every vertex from the second on also ends a candidate with
+// rs_path_contribution), is the source pdf's too, so the walks carry neither and a candidate's
+// weight p̂ / p needs no optical depth (the target clamps tau_c at VOL_MAX_TAU = 80, where the two
+// part: a path beyond it is sampled with probability below e^-80); the reservoir's p̂ of the
+// selected path, which reuse needs, is the target evaluated once on the stored path (rs_target).
+// With an emitting medium (PLUME_HAS_EMISSION) every vertex from the second on also ends a candidate with
 // its own emission (sigma_a Le at x_j, pdf without a light factor; light = RS_LIGHT_EMISSION), up
 // to vertex max_bounces + 1: both ends go through the one reservoir, so reuse shares good
 // emitters too. Emission seen directly (a one-vertex path) is final shading's, by tracking along

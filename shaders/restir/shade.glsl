@@ -1,8 +1,9 @@
 // Final shading (DESIGN §4.2 step 7): the selected path evaluated once with unbiased
 // transmittance times W = w_sum / p̂(Y): residual ratio tracking against the mean field, whose
-// transmittances of the path's segments are p̂'s own factors (so only the ratio of the fine ones to
-// them is estimated, bridge.glsl rs_path_contribution), and of the light ray; plus the radiance of the camera ray escaping the scene (light_escaped, also
-// by residual ratio tracking) and the medium's emission seen directly, which no reservoir path
+// transmittances of the path's segments are p̂'s own factors (so only the ratio of the fine ones
+// to them is estimated, bridge.glsl rs_path_contribution), and on the light ray; plus the
+// radiance of the camera ray escaping the scene (light_escaped, also by residual ratio tracking)
+// and the medium's emission seen directly, which no reservoir path
 // covers; with emissive surfaces, the lamps seen directly from their reservoir of their own; plus,
 // when max_bounces exceeds the prefix K that reservoirs hold (or, in an emitting medium,
 // max_bounces + 1 exceeds the emitting prefix rs_emission_vertices), the tail: the longer paths,
