@@ -221,7 +221,9 @@ TEST(View, PanelIsDrawnOverTheImageWhenShown) {
 // lavapipe a timestamp was taken by llvmpipe's rasterizer at its next flush as soon as a
 // framebuffer had been bound (the panel's), so every pass of every frame after the first read
 // ~0.03 ms (their sum 0.2% of the frame); gpu/pipeline.cpp GpuTimer::stamp. ReSTIR's passes are
-// most of a viewer frame.
+// a large part of a viewer frame even at this small size: 3.4 of 18 ms (19%) in session 27, whose
+// faster passes took them below the 20% this test asked until then; 5% is still 25 times the
+// broken timestamps' share.
 TEST(View, PassTimesWithThePanelShownAreThePassesOwn) {
   if (!haveXvfbRun()) GTEST_SKIP() << "xvfb-run is not installed";
   std::string log;
@@ -248,7 +250,7 @@ TEST(View, PassTimesWithThePanelShownAreThePassesOwn) {
     at = end + 2;
   }
   EXPECT_GE(count, 3) << line;
-  EXPECT_GT(renderer, 0.2 * frameMs) << "the renderer's passes, " << renderer << " ms, in a frame of " << frameMs
+  EXPECT_GT(renderer, 0.05 * frameMs) << "the renderer's passes, " << renderer << " ms, in a frame of " << frameMs
                                      << " ms:\n" << log;
 }
 
