@@ -28,7 +28,7 @@
 // The reservoir's confidence is M. A dispatch walks rsp.walksPerDispatch of the M walks
 // (lavapipe's loop budget, docs/architecture.md: an invocation walks at most
 // RS_CANDIDATE_VERTICES vertices, or one walk of K, whatever M): the walks stream their
-// candidates into the pixel's running reservoir, kept between dispatches (w_sum, p̂ and the
+// candidates into the pixel's running reservoir, kept between dispatches (w_sum and the
 // candidates' random stream in the pixel's state slot, the selected path in the output set), and
 // the dispatch of the last walk finalises it: the same draws in the same order as M walks in one
 // invocation. Requires restir/bridge.glsl.
@@ -157,8 +157,7 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
     head.lightPrim = 0u;
   } else {  // the walks before this one
     vec4 state = rs_state(rs_state_slot(pixelIndex));
-    r.w_sum = state.x;
-    r.p_hat = state.y;
+    r.w_sum = state.x;  // (p̂ is evaluated on the selected path at the end)
     rng.counter = floatBitsToUint(state.z);
     head = rs_load_head(outSet, pixelIndex);
   }
@@ -343,7 +342,7 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
     }
   }
   if (last < M) {
-    rs_set_state(rs_state_slot(pixelIndex), vec4(r.w_sum, r.p_hat, uintBitsToFloat(rng.counter), 0.0f));
+    rs_set_state(rs_state_slot(pixelIndex), vec4(r.w_sum, 0.0f, uintBitsToFloat(rng.counter), 0.0f));
     rs_store_head(outSet, pixelIndex, head);
     return;
   }

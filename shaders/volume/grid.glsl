@@ -49,16 +49,22 @@ ivec3 vol_slot_coords(uint packed) {
 }
 
 // Where the trilinear lookup at index-space point p reads volume v's atlas: the texel t of voxel
-// floor(p) (its 8 corners are t + {0,1}³) and the weights' fractions f. False where p's brick is
-// empty (every lookup there is 0).
-bool vol_locate(uint v, vec3 p, out ivec3 t, out vec3 f) {
+// floor(p) (its 8 corners are t + {0,1}³) and the weights' fractions f; the voxel's brick slot and
+// its place sub in the brick. False where p's brick is empty (every lookup there is 0).
+bool vol_locate_voxel(uint v, vec3 p, out uint slot, out ivec3 sub, out ivec3 t, out vec3 f) {
   vec3 fl = floor(p);
   ivec3 vox = ivec3(fl);
   ivec3 b = vox >> 3;
-  uint slot = vol_packed_slot(v, b);
+  slot = vol_packed_slot(v, b);
+  sub = vox - b * VOL_BRICK;
   f = p - fl;
-  t = vol_slot_coords(slot) * VOL_TEXELS + (vox - b * VOL_BRICK) + 1;
+  t = vol_slot_coords(slot) * VOL_TEXELS + sub + 1;
   return slot != 0u;
+}
+bool vol_locate(uint v, vec3 p, out ivec3 t, out vec3 f) {
+  uint slot;
+  ivec3 sub;
+  return vol_locate_voxel(v, p, slot, sub, t, f);
 }
 
 // Corner c's trilinear weight (exact: the product of the fractions, no hardware filtering).
@@ -192,6 +198,11 @@ uint vol_mean_field_base(uint v, uint slot) {
   ivec3 slots = VOL_PARAM(v, atlasSlots);
   ivec3 s = vol_slot_coords(slot);
   return (uint(s.x) + uint(slots.x) * (uint(s.y) + uint(slots.y) * uint(s.z))) * VOL_BRICK_VOXELS;
+}
+
+// Mean-field voxel sub of the brick in packed slot `slot` (its index for vol_mean_field).
+uint vol_mean_field_index(uint v, uint slot, ivec3 sub) {
+  return vol_mean_field_base(v, slot) + uint((sub.z * VOL_BRICK + sub.y) * VOL_BRICK + sub.x);
 }
 
 // (mean, residual bound) of the density in mean-field voxel i (bake.h packedMeanField): the mean

@@ -256,9 +256,8 @@ float vol_track_segment(uint tracker, inout VolTrack s, float a, float b, vec2 v
 // --- Exact voxels of the mean field ----------------------------------------------------------------
 // Inside one voxel the fine density is one trilinear polynomial of its 8 corner texels (the
 // voxel of vol_locate), so along a segment it is a cubic in the segment's parameter u in [0, 1]:
-// two-point Gauss-Legendre integrates it exactly, and sampling inverts that integral (a
-// monotone quartic) by safeguarded Newton steps. The density at the collision is the one the
-// pdf needs, sigma exp(-tau), as for a constant voxel.
+// two-point Gauss-Legendre integrates it exactly. (Collisions in the field are sampled by delta
+// tracking, which reads the density at a point: vol_fine_and_mean.)
 struct VolExact {
   float c[8];  // corner texels, vol_corner_weight's order
   vec3 fa;     // fractions in the voxel at the segment's start
@@ -310,14 +309,13 @@ float vol_track_exact(uint tracker, inout VolTrack s, VolWalk w, float scale, fl
 // majorant to its voxels' largest mean where rounding put a mean above it), so delta tracking
 // against them samples the mean field's collisions (VOL_TRACK_SAMPLE).
 vec2 vol_fine_and_mean(uint v, float scale, vec3 p, float exactBound) {
-  vec3 fl = floor(p);
-  ivec3 voxel = ivec3(fl);
-  ivec3 brick = voxel >> 3;
-  uint slot = vol_packed_slot(v, brick);
-  if (slot == 0u) return vec2(0.0f);
-  ivec3 sub = voxel - brick * VOL_BRICK;
-  float fine = scale * vol_density_at(v, vol_slot_coords(slot) * VOL_TEXELS + sub + 1, p - fl);  // as vol_locate
-  vec2 m = scale * vol_mean_field(v, vol_mean_field_base(v, slot) + uint((sub.z * VOL_BRICK + sub.y) * VOL_BRICK + sub.x));
+  uint slot;
+  ivec3 sub;
+  ivec3 t;
+  vec3 f;
+  if (!vol_locate_voxel(v, p, slot, sub, t, f)) return vec2(0.0f);
+  float fine = scale * vol_density_at(v, t, f);
+  vec2 m = scale * vol_mean_field(v, vol_mean_field_index(v, slot, sub));
   return vec2(fine, m.y > exactBound ? fine : m.x);
 }
 #endif
@@ -352,7 +350,8 @@ void vol_track_event(uint tracker, inout VolTrack s, uint v, float scale, vec3 p
       s.stop = true;
     }
   } else if (tracker == VOL_TRACK_RESIDUAL_RATIO) {
-    // The fine density and the mean field both lie in [0, mu]: the factor in [0, 2].
+    // The fine density and the mean field both lie in [0, mu / PLUME_RS_RATIO_SCALE]: the factor
+    // in [1 - 1 / scale, 1 + 1 / scale], [0.75, 1.25] at the default 4.
     vec2 sigma = vol_fine_and_mean(v, scale, p, exactBound);
     s.value *= 1.0f - (sigma.x - sigma.y) / mu;
   }
@@ -466,7 +465,7 @@ void vol_track_by_collision(uint tracker, uint v, inout VolTrack s, inout VolWal
 // tracker's closed form for the voxel and, for RESIDUAL, the draws of its tentative collisions;
 // it leaves for the rare work, which the outer loop does: a new brick (the indirection read and
 // the voxel DDA's set-up; empty bricks in their own tight loop), an exact voxel (8 texel reads,
-// Gauss-Legendre, Newton) and a tentative collision's density lookup. As one loop over segments
+// Gauss-Legendre) and a tentative collision's density lookup. As one loop over segments
 // (vol_walk_next), every voxel paid for all three on lavapipe: ReSTIR's candidates ran 3.7x and
 // its spatial reuse 2.2x slower (notes/bench/kernels.md, "Session 14"). The same segments in the
 // same order, so the same results to the bit.
@@ -615,7 +614,8 @@ void vol_track_mean_residual(uint tracker, uint v, inout VolTrack s, inout VolWa
   }
 }
 #endif
-// The walk. `init`: the tracker's starting value (RATIO, RESIDUAL 1; TAU 0; DELTA, SAMPLE unused). Each tentative collision of the majorant's (or the residual's) Poisson
+// The walk. `init`: the tracker's starting value (RATIO, RESIDUAL, RESIDUAL_RATIO 1; TAU 0;
+// DELTA, SAMPLE unused). Each tentative collision of the majorant's (or the residual's) Poisson
 // process draws one rng_next4: its x the optical depth Exp(1) to it from the last one, spent
 // across segments of different rates (the inverse of the piecewise-linear optical depth), its y
 // the event's u.
@@ -740,7 +740,7 @@ float vol_mean_tau_midpoints(uint v, vec3 xWorld, vec3 wWorld, float tMax) {
     ivec3 brick = ivec3(floor(vec3(voxel) * (1.0f / float(VOL_BRICK))));
     ivec3 sub = clamp(voxel - brick * VOL_BRICK, ivec3(0), ivec3(VOL_BRICK - 1));
     uint slot = vol_packed_slot(v, brick);
-    uint at = slot != 0u ? vol_mean_field_base(v, slot) + uint((sub.z * VOL_BRICK + sub.y) * VOL_BRICK + sub.x) : 0u;
+    uint at = slot != 0u ? vol_mean_field_index(v, slot, sub) : 0u;
     vec2 m = slot != 0u ? vol_mean_field(v, at) : vec2(0.0f);
     sum += m.y > exactResidual && m.y > 2.0f * m.x ? 0.0f : m.x;
   }
@@ -781,8 +781,8 @@ float vol_residual_tr(vec3 xWorld, vec3 wWorld, float tMax, inout RngState rng) 
 // An unbiased estimate of the ratio T / exp(-tau_c) of the current volume's fine transmittance
 // over (0, tMax) to its mean field's (vol_fine_and_mean), without walking the mean field: residual
 // ratio tracking's product alone, prod_i (1 - (sigma(x_i) - sigma_c(x_i)) / mu) over a Poisson
-// process of rate mu = PLUME_RS_RATIO_SCALE brick majorants, whose expectation is exp(-int (sigma - sigma_c)). Where
-// a caller knows exp(-tau_c) already (final shading: it is part of the reservoir's p̂,
+// process of rate mu = PLUME_RS_RATIO_SCALE brick majorants, whose expectation is
+// exp(-int (sigma - sigma_c)). Where a caller knows exp(-tau_c) already (final shading: it is part of the reservoir's p̂,
 // restir/shade.glsl), this is all the unbiased transmittance needs: a few tentative collisions a
 // brick instead of every voxel crossed. Relative variance exp(int (sigma - sigma_c)² / mu) - 1.
 float vol_residual_ratio(vec3 xWorld, vec3 wWorld, float tMax, inout RngState rng) {
