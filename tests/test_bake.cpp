@@ -339,7 +339,7 @@ TEST(Bake, WithoutTheMeanFieldTheRestIsTheSame) {
     }
   }
   std::printf("[bake] %d of %zu majorants raised to the bricks' largest means\n", raised, ma0.size());
-  // The coarser levels are the maxima of the finer ones.
+  // The coarser levels (maxima of the finer ones) are no lower than without the field either.
   for (size_t k = 1; k < a.maxLevels.size(); ++k)
     for (size_t i = 0; i < a.maxLevels[k].max.size(); ++i) EXPECT_GE(a.maxLevels[k].max[i], b.maxLevels[k].max[i]) << k;
   const MemoryReport ma = memoryReport(a), mb = memoryReport(b);
