@@ -24,7 +24,7 @@ void main() {
   vec4 a = ptAccum[2u * index];
   vec3 m2a = ptAccum[2u * index + 1u].rgb;
   for (uint slot = i; slot < ptPush.slots; slot += ptPush.pixelCount) {
-    acc_merge(a, m2a, ptPaths[slot].radiance, vec3(0.0f), 1.0f);
+    acc_merge(a, m2a, pt_radiance(slot), vec3(0.0f), 1.0f);
   }
   ptAccum[2u * index] = a;
   ptAccum[2u * index + 1u] = vec4(m2a, 0.0f);

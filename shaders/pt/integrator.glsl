@@ -142,7 +142,7 @@ bool pt_camera(uint slot) {
   return true;
 #else
   if (vol_may_meet(frame.camera.position, dir)) return true;
-  ptPaths[slot].radiance = light_escaped(dir);
+  pt_set_radiance(slot, light_escaped(dir));
   return false;
 #endif
 }
@@ -212,7 +212,7 @@ bool pt_extend(uint slot, bool camera) {
   // A finished path leaves only its radiance (pt_resolve reads nothing else). The ray (dir,
   // phasePdf) is the one shading drew, or the camera's: stored only for a camera ray.
   if (!vertex) {
-    ptPaths[slot].radiance = p.radiance;
+    pt_set_radiance(slot, p.radiance);
     return false;
   }
   if (camera) {
@@ -246,7 +246,7 @@ bool pt_shade(uint slot) {
   more = path_roulette(p.scatterings, min(1.0f, plume_max3(p.beta)), rng, p.beta) &&
          path_scatter(v, rng_float2(rng), p.beta, p.origin, p.dir, p.phasePdf);
 #endif
-  ptPaths[slot].radiance = p.radiance;
+  pt_set_radiance(slot, p.radiance);
 #ifdef PT_FOLLOWS_PHASE
   if (more) {
     p.counter = rng.counter;

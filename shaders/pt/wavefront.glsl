@@ -38,31 +38,52 @@ struct PtPath {
 
 const uint PT_MEDIUM_VERTEX = 0xffffffffu;
 
+// The path slots, PT_PATH_TEXELS texels of four words each in PtPath's std430 layout (origin and
+// phasePdf, dir and scatterings, beta and counter, radiance and prim, shading), bound twice: as a
+// storage buffer of PtPath, written field by field (only the fields a kernel changes), and as a
+// uniform texel buffer of uvec4, read a texel at a time. On a SIMD back end such as lavapipe a
+// storage buffer's per-lane word is a scalar loop over the lanes with a bounds check each, a
+// texel fetch one gather (docs/architecture.md, "Descriptor kinds"); a texel store through a
+// storage texel buffer was slower still than the word stores (session 28, the bundled smoke at
+// 128², 16 samples: the camera kernel 5.0 -> 6.7 ms, extension 13.1 -> 15.2). The texel reads made
+// extension and shading ~2-3% faster than the word reads.
 layout(std430, binding = BIND_PT_PATHS) buffer PathBuffer { PtPath ptPaths[]; };
-// [0, slots): the paths to extend; [slots, 2 slots): the paths to shade.
+layout(binding = BIND_PT_PATH_TEXELS) uniform usamplerBuffer ptPathTexels;
+uvec4 pt_texel(uint slot, uint k) { return texelFetch(ptPathTexels, int(slot * PT_PATH_TEXELS + k)); }
+vec3 pt_xyz(uvec4 t) { return uintBitsToFloat(t.xyz); }
+
+// The path's radiance so far (the resolve's read: a storage buffer's, faster there than the texel
+// fetch, whose lanes each read another slot's cache line).
+vec3 pt_radiance(uint slot) { return ptPaths[slot].radiance; }
+void pt_set_radiance(uint slot, vec3 radiance) { ptPaths[slot].radiance = radiance; }
+
 layout(std430, binding = BIND_PT_QUEUES) buffer QueueBuffer { uint ptQueues[]; };
+// [0, slots): the paths to extend; [slots, 2 slots): the paths to shade.
 layout(std430, binding = BIND_PT_WAVE) buffer WaveBuffer { PtWave wave; };
 layout(push_constant) uniform PtPushBlock { PtPush ptPush; };
 
-// A path's fields are read and written one by one, only those a kernel needs or changes: on a
-// SIMD back end each storage-buffer word costs a scalar loop over the lanes (LAVAPIPE.md).
-// Extension reads the ray it follows and what it adds to (atVertex false); shading, the vertex it
-// waits at (atVertex true; a constant at each call).
+// A path is read a texel at a time and written field by field, only what a kernel needs or
+// changes. Extension reads the ray it follows and what it adds to (atVertex false); shading, the
+// vertex it waits at (atVertex true; a constant at each call).
 PtPath pt_load(uint slot, const bool atVertex) {
   PtPath p;
-  p.origin = ptPaths[slot].origin;
-  p.dir = ptPaths[slot].dir;
-  p.scatterings = ptPaths[slot].scatterings;
-  p.beta = ptPaths[slot].beta;
-  p.counter = ptPaths[slot].counter;
-  p.radiance = ptPaths[slot].radiance;
-  p.phasePdf = atVertex ? 0.0f : ptPaths[slot].phasePdf;
+  uvec4 t0 = pt_texel(slot, 0u);
+  uvec4 t1 = pt_texel(slot, 1u);
+  uvec4 t2 = pt_texel(slot, 2u);
+  uvec4 t3 = pt_texel(slot, 3u);
+  p.origin = pt_xyz(t0);
+  p.phasePdf = uintBitsToFloat(t0.w);
+  p.dir = pt_xyz(t1);
+  p.scatterings = t1.w;
+  p.beta = pt_xyz(t2);
+  p.counter = t2.w;
+  p.radiance = pt_xyz(t3);
   p.prim = PT_MEDIUM_VERTEX;
   p.shading = vec3(0.0f);
 #ifdef PLUME_HAS_SURFACES
   if (atVertex) {
-    p.prim = ptPaths[slot].prim;
-    p.shading = ptPaths[slot].shading;
+    p.prim = t3.w;
+    p.shading = pt_xyz(pt_texel(slot, 4u));
   }
 #endif
   p.pad = 0u;

@@ -21,9 +21,10 @@ const uint BIND_LIGHTS = 6u;           // GpuLight[]
 
 // The wavefront path tracer (shaders/pt/wavefront.glsl, shaders/passes/pt_*.comp).
 const uint BIND_PT_ACCUM = 7u;         // per pixel: vec4(mean rgb, n), vec4(M2 rgb, 0)
-const uint BIND_PT_PATHS = 8u;         // per path slot: 4 x vec4 (PtPath)
+const uint BIND_PT_PATHS = 8u;         // per path slot: PT_PATH_TEXELS uvec4 texels (PtPath)
 const uint BIND_PT_QUEUES = 9u;        // uint[2 * slots]: the paths to extend, then those to shade
 const uint BIND_PT_WAVE = 10u;         // PtWave: queue lengths and the indirect dispatches
+const uint BIND_PT_PATH_TEXELS = 15u;  // the path slots again, read as a uniform texel buffer
 
 // The scene's surfaces (shaders/surface/surfaces.glsl; render/gpu_surfaces.cpp), in the
 // estimators that render them (PLUME_HAS_SURFACES).

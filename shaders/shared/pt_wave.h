@@ -11,7 +11,7 @@
 PLUME_NS_BEGIN
 
 const uint PT_WAVE_GROUP = 64u;  // invocations per workgroup of the queue kernels
-const uint PT_PATH_BYTES = 80u;  // a slot's path between kernels (PtPath, pt/wavefront.glsl)
+const uint PT_PATH_TEXELS = 5u;  // a slot's path between kernels: texels of 4 words (PtPath, pt/wavefront.glsl)
 
 // Queue lengths and the indirect dispatches (x, y, z groups; w the queue's length) of the two
 // queue kernels. extendCount is appended to by shading, shadeCount by extension; pt_queue.comp

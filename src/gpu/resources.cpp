@@ -128,7 +128,10 @@ TexelBuffer::TexelBuffer(Context& ctx, const void* data, size_t count, VkFormat 
                           kTooLargeHint));
   }
   buffer_ = Buffer(ctx, count * texelBytes,
-                   storage ? VK_BUFFER_USAGE_STORAGE_TEXEL_BUFFER_BIT : VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT, name);
+                   storage ? VK_BUFFER_USAGE_STORAGE_TEXEL_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                 VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT
+                           : VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT,
+                   name);
   if (data && given > 0) buffer_.upload(data, given * texelBytes);
   VkBufferViewCreateInfo vi{VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO};
   vi.buffer = buffer_.handle();

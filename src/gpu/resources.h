@@ -58,7 +58,9 @@ class TexelBuffer {
   // `format`: VK_FORMAT_R32_SFLOAT, VK_FORMAT_R32_UINT (4 bytes per element),
   // VK_FORMAT_R32G32B32A32_SFLOAT or _UINT (16); `count` elements, uploaded from `data` where
   // not null. `storage`: a storage texel buffer (imageBuffer, read and written; zeroed with
-  // fillZero) instead of a uniform one (samplerBuffer, read only).
+  // fillZero) instead of a uniform one (samplerBuffer, read only); its buffer() may then also be
+  // bound as a storage buffer and the view as a uniform texel buffer (the path tracer's slots:
+  // written word by word, read a texel at a time).
   TexelBuffer(Context& ctx, const void* data, size_t count, VkFormat format, const std::string& name,
               bool storage = false);
   ~TexelBuffer();
@@ -66,6 +68,7 @@ class TexelBuffer {
   TexelBuffer& operator=(TexelBuffer&& o) noexcept;
 
   VkBufferView view() const { return view_; }
+  const Buffer& buffer() const { return buffer_; }
   void fillZero() { buffer_.fillZero(); }
 
  private:

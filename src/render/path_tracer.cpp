@@ -39,12 +39,16 @@ PathTracer::PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const S
   // kGenerationPaths pixels with up to kMaxSlots / kGenerationPaths samples each (one sample per
   // band of kMaxSlots pixels, until session 25, cost its resolve ~43 ns a pixel and sample on
   // lavapipe, ~20% of a 1024² frame; four per band amortise the resolve's invocations).
-  if (pixels <= kGenerationPaths) {
+  // The slots are a storage texel buffer of PT_PATH_TEXELS texels each: fewer of them where the
+  // device allows fewer texels (Vulkan's minimum, 65536 texels, holds 13107; lavapipe 2^27).
+  const uint32_t maxSlots = std::min<uint32_t>(kMaxSlots, ctx.limits().maxTexelBufferElements / shared::PT_PATH_TEXELS);
+  const uint32_t generationPaths = std::min(kGenerationPaths, maxSlots);
+  if (pixels <= generationPaths) {
     bandPixels_ = uint32_t(std::max<size_t>(pixels, 1));
-    slots_ = uint32_t(std::max<size_t>(1, kGenerationPaths / bandPixels_) * bandPixels_);
+    slots_ = uint32_t(std::max<size_t>(1, generationPaths / bandPixels_) * bandPixels_);
   } else {
-    bandPixels_ = kGenerationPaths;
-    slots_ = kMaxSlots;
+    bandPixels_ = generationPaths;
+    slots_ = maxSlots / generationPaths * generationPaths;
   }
   // The accumulation (32 bytes a pixel) in as few buffers as the device's largest storage buffer
   // allows (lavapipe: 128 MiB, 4.2 megapixels; a 3840x2160 image needs two), each a whole number
@@ -63,7 +67,8 @@ PathTracer::PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const S
     accums_.emplace_back(ctx, std::max<size_t>(n, 1) * kAccumBytes, storage,
                          n == pixels ? std::string("accumulation") : strf("accumulation part %zu", accums_.size()));
   }
-  paths_ = gpu::Buffer(ctx, size_t(slots_) * shared::PT_PATH_BYTES, storage, "path slots");
+  paths_ = gpu::TexelBuffer(ctx, nullptr, size_t(slots_) * shared::PT_PATH_TEXELS, VK_FORMAT_R32G32B32A32_UINT,
+                           "path slots", true);
   queues_ = gpu::Buffer(ctx, size_t(slots_) * 2 * sizeof(uint32_t), storage, "path queues");
   wave_ = gpu::Buffer(ctx, sizeof(shared::PtWave), storage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, "path queue lengths");
   const gpu::ShaderDefines none;
@@ -77,7 +82,9 @@ PathTracer::PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const S
 
 // The descriptor types of the kernels that walk the scene (the rest are storage buffers).
 gpu::BindingTypes PathTracer::volumeTypes() const {
-  return sceneBindingTypes(false, features_.emission, features_.surfaces, 0);
+  gpu::BindingTypes types = sceneBindingTypes(false, features_.emission, features_.surfaces, 0);
+  types.emplace_back(shared::BIND_PT_PATH_TEXELS, gpu::BindingType::TexelBuffer);
+  return types;
 }
 
 std::unique_ptr<gpu::ComputePass> PathTracer::makePass(const std::string& file, const gpu::ShaderDefines& defines,
@@ -89,14 +96,16 @@ std::unique_ptr<gpu::ComputePass> PathTracer::makePass(const std::string& file, 
   // the volume's images are in the tables of the kernels that walk it, the emission atlas only
   // where the scene emits.
   std::vector<BindingType> table =
-      !volumeTable ? gpu::bindingTable(shared::BIND_PT_WAVE + 1, {})
+      !volumeTable ? gpu::bindingTable(shared::BIND_PT_PATH_TEXELS + 1,
+                                       {{shared::BIND_PT_PATH_TEXELS, gpu::BindingType::TexelBuffer}})
       : gpu::bindingTable(features_.emission ? shared::BIND_BLACKBODY + 1 : shared::BIND_ENV_MAP + 1, volumeTypes());
   auto pass = std::make_unique<gpu::ComputePass>(ctx_, compiler_.compile(file, all), std::move(table),
                                                  uint32_t(sizeof(shared::PtPush)), name,
                                                  glm::uvec3(shared::PT_WAVE_GROUP, 1, 1));
   pass->set.bind(shared::BIND_FRAME, frameBuffer_);
   pass->set.bind(shared::BIND_PT_ACCUM, accums_[0]);  // the resolve passes rebind their band
-  pass->set.bind(shared::BIND_PT_PATHS, paths_);
+  pass->set.bind(shared::BIND_PT_PATHS, paths_.buffer());
+  pass->set.bind(shared::BIND_PT_PATH_TEXELS, paths_);
   pass->set.bind(shared::BIND_PT_QUEUES, queues_);
   pass->set.bind(shared::BIND_PT_WAVE, wave_);
   if (volumeTable) {

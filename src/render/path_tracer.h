@@ -91,7 +91,8 @@ class PathTracer {
   uint32_t accumPixels_ = 0;
   uint32_t bandPixels_ = 0;           // pixels per generation
   gpu::TexelBuffer lightBuffer_;
-  gpu::Buffer paths_, queues_, wave_;  // the wavefront's path slots, queues and PtWave
+  gpu::TexelBuffer paths_;             // the wavefront's path slots (a storage texel buffer)
+  gpu::Buffer queues_, wave_;          // its queues and PtWave
   uint32_t slots_ = 0;                 // path slots allocated
   shared::GpuFrame frame_{};
   int samples_ = 0;

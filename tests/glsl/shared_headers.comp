@@ -165,7 +165,7 @@ void main() {
   // surface_types.h (layouts only)
   GpuSurfaceMaterial material;
   material.bsdf = bsdf;
-  material.emission = vec3(PT_PATH_BYTES);
+  material.emission = vec3(PT_PATH_TEXELS);
   // light_tree.h
   GpuLightNode node;
   node.boxMin = vec3(-1.0f);
