@@ -29,6 +29,7 @@ struct KernelCase {
 struct KernelResult {
   glm::uvec4 rng0, rng1;
   glm::vec4 phase, hgDir, coneDir;
+  glm::uvec4 walk;
 };
 
 class GpuShared : public test::GpuTest {
@@ -139,6 +140,10 @@ TEST_F(GpuShared, GlslAndCppAgree) {
     glm::vec3 hg = sh::ph_hg_sample(glm::vec3(c.dir), gg, u), cone = sh::smp_uniform_cone(glm::vec3(c.dir), 0.1f, u);
     for (int a = 0; a < 3; ++a) ok = ok && near(g.hgDir[a], hg[a], 1e-4f) && near(g.coneDir[a], cone[a], 1e-4f);
     floatMismatches += !ok;
+    sh::RngWalk walk = sh::rng_walk_init(r);
+    glm::uvec4 w;
+    for (int k = 0; k < 4; ++k) w[k] = sh::rng_walk_next(walk);
+    rngMismatches += w != g.walk;
     const float d = sampleDensity(bake, glm::vec3(c.point));
     const double err = std::abs(double(g.phase.z) - d);
     worstDensity = std::max(worstDensity, err);

@@ -19,7 +19,7 @@ namespace {
 constexpr int kDraws = 1000000;
 constexpr int kBins = 100;
 // Tests of independence in this file: their chi-squares share a Šidák-corrected level.
-constexpr int kIndependenceTests = 5;
+constexpr int kIndependenceTests = 8;
 // |Pearson correlation| of n independent uniform pairs has standard deviation 1/sqrt(n).
 constexpr double kCorrelationSigmas = 5.0;
 
@@ -127,6 +127,55 @@ TEST(Rng, ConsecutiveDrawsAreIndependent) {
     const float x = rng_float(r);
     return vec2(x, rng_float(r));
   }, "serial");
+}
+
+// The walks' generator (rng_walk_*: xoshiro128+ seeded by one draw of the stream). A tentative
+// collision takes two numbers in a row (its optical depth and its u); a walk takes as many pairs
+// as it has collisions, the next walk of the path a new state from the stream's next draw.
+TEST(Rng, WalkUniformWithinOneWalk) {
+  RngState r = rng_init(uvec2(3u, 5u), 7u, RNG_STREAM_PATH, 1u);
+  RngWalk g = rng_walk_init(r);
+  std::vector<double> counts(kBins, 0.0);
+  for (int i = 0; i < kDraws; ++i) counts[size_t(bin(rng_to_float(rng_walk_next(g)), kBins))] += 1.0;
+  expectChi2(counts, "walk_one");
+}
+
+TEST(Rng, WalkUniformAtEachDrawAcrossWalks) {
+  // Draw k of the walks of many paths (short walks read only their first few).
+  RngState r = rng_init(uvec2(9u, 2u), 1u, RNG_STREAM_PATH, 4u);
+  std::vector<std::vector<double>> counts(4, std::vector<double>(kBins, 0.0));
+  for (int i = 0; i < kDraws; ++i) {
+    RngWalk g = rng_walk_init(r);
+    for (int k = 0; k < 4; ++k) counts[size_t(k)][size_t(bin(rng_to_float(rng_walk_next(g)), kBins))] += 1.0;
+  }
+  for (int k = 0; k < 4; ++k) expectChi2(counts[size_t(k)], "walk_draw" + std::to_string(k), 4);
+}
+
+TEST(Rng, WalkPairsAreIndependent) {
+  // A collision's two numbers: the first pair of each walk, and pairs deep in one walk.
+  RngState r = rng_init(uvec2(1u, 8u), 0u, RNG_STREAM_PATH, 2u);
+  expectIndependent([&r](int) {
+    RngWalk g = rng_walk_init(r);
+    const float x = rng_to_float(rng_walk_next(g));
+    return vec2(x, rng_to_float(rng_walk_next(g)));
+  }, "walk_first_pair");
+  RngWalk deep = rng_walk_init(r);
+  expectIndependent([&deep](int) {
+    const float x = rng_to_float(rng_walk_next(deep));
+    return vec2(x, rng_to_float(rng_walk_next(deep)));
+  }, "walk_serial");
+}
+
+TEST(Rng, ConsecutiveWalksAreIndependent) {
+  // The first number of a path's walk and of its next walk (the stream's consecutive draws), and of
+  // neighbouring pixels' walks.
+  RngState r = rng_init(uvec2(4u, 4u), 3u, RNG_STREAM_PATH, 6u);
+  expectIndependent([&r](int i) {
+    RngWalk a = rng_walk_init(r);
+    RngWalk b = rng_walk_init(r);
+    if (i % 2 == 1) rng_walk_next(b);  // (a shorter and a longer first walk alike)
+    return vec2(rng_to_float(rng_walk_next(a)), rng_to_float(rng_walk_next(b)));
+  }, "walk_next_walk");
 }
 
 TEST(Rng, Deterministic) {

@@ -253,6 +253,12 @@ TEST(Stats, ZTestZeroVarianceAndNonFinite) {
   r = zTest(a, b);
   EXPECT_FALSE(r.pass);
   EXPECT_EQ(r.worstChannel, 1);
+  b.rgb[1] = 1e-37f;  // ~8.5 times the absolute floor (the smallest normal float)
+  r = zTest(a, b);
+  EXPECT_FALSE(r.pass);
+  EXPECT_NEAR(r.worstZ, -1e-37 / double(std::numeric_limits<float>::min()), 0.01);
+  b.rgb[1] = 1.68e-44f;  // a denormal (the Blender fire's red tail): float rounding, not a bias
+  EXPECT_TRUE(zTest(a, b).pass);
   b = a;
   b.rgb[4] = std::numeric_limits<float>::quiet_NaN();
   b.var[4] = 1.0f;

@@ -62,6 +62,38 @@ PLUME_FN vec2 rng_float2(INOUT(RngState) r) {
   return vec2(rng_to_float(h.x), rng_to_float(h.y));
 }
 
+// A walk's own generator (the volume's tracking loops, shaders/volume/walk.glsl): xoshiro128+
+// (Blackman & Vigna, "Scrambled linear pseudorandom number generators", 2021), its 128-bit state
+// one draw of the stream that walks. Each tentative collision takes two numbers; through the
+// counter-based hash each would cost a pcg4d, whose eight dependent multiplies are the longest
+// chain of a tracking step on a SIMD back end that runs one subgroup at a time (lavapipe), where
+// xoshiro128+ is a few shifts and xors. Only the top 24 bits are used (rng_to_float): those of
+// xoshiro128+ pass BigCrush; its weak low bits are never read. The stream's counter advances once
+// per walk, so every walk's numbers are still a function of (pixel, frame, stream, seed, counter).
+struct RngWalk {
+  uvec4 s;
+};
+
+PLUME_FN RngWalk rng_walk_init(INOUT(RngState) r) {
+  RngWalk g;
+  g.s = rng_next4(r);
+  if (g.s.x == 0u && g.s.y == 0u && g.s.z == 0u && g.s.w == 0u) g.s.x = 1u;  // (the one state it never leaves)
+  return g;
+}
+
+// The next 32 bits (use the top ones: rng_to_float).
+PLUME_FN uint rng_walk_next(INOUT(RngWalk) g) {
+  uint result = g.s.x + g.s.w;
+  uint t = g.s.y << 9u;
+  g.s.z ^= g.s.x;
+  g.s.w ^= g.s.y;
+  g.s.y ^= g.s.z;
+  g.s.x ^= g.s.w;
+  g.s.z ^= t;
+  g.s.w = (g.s.w << 11u) | (g.s.w >> 21u);
+  return result;
+}
+
 PLUME_NS_END
 
 #endif

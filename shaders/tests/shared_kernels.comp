@@ -23,6 +23,7 @@ struct KernelResult {
   vec4 phase;   // x: ph_hg(cos, g), y: ph_hg_sample_cos(g, u), z: vol_density(point)
   vec4 hgDir;   // ph_hg_sample(wi, g, u2)
   vec4 coneDir; // smp_uniform_cone(wi, 0.1, u2)
+  uvec4 walk;   // after those: a walk generator's first four rng_walk_next
 };
 
 // Bindings after the volume's (shared/bindings.h): this test pass's own.
@@ -46,5 +47,10 @@ void main() {
   o.phase = vec4(ph_hg(c.dir.w, g), ph_hg_sample_cos(g, u.x), vol_density(VOL_CURRENT, c.point.xyz), 0.0f);
   o.hgDir = vec4(ph_hg_sample(c.dir.xyz, g, u), 0.0f);
   o.coneDir = vec4(smp_uniform_cone(c.dir.xyz, 0.1f, u), 0.0f);
+  RngWalk walk = rng_walk_init(r);
+  o.walk.x = rng_walk_next(walk);
+  o.walk.y = rng_walk_next(walk);
+  o.walk.z = rng_walk_next(walk);
+  o.walk.w = rng_walk_next(walk);
   results[i] = o;
 }

@@ -204,11 +204,15 @@ struct VolTrack {
 // chose 0.01; session 20 measured 0.1 against it, two seeds, `plume bench` at 128²: the Blender
 // fire's path tracer 9-13% faster per frame at the same or lower relMSE, the bundled smoke equal;
 // next-event lookups per pixel had been 21% above the reference's; notes/bench/kernels.md).
+// u: the tentative collision's own uniform (its second number, which ratio tracking's event does
+// not otherwise read), independent of the optical depth that placed the collision and of the
+// estimate so far; a draw of its own ran on every event of a SIMD back end's masked loop whether
+// a lane needed it or not (the path tracer's shading ~10% faster without it, session 28).
 const float VOL_RR_TRANSMITTANCE = 0.1f;
-bool vol_transmittance_roulette(inout float tr, inout RngState rng) {
+bool vol_transmittance_roulette(inout float tr, float u) {
   float m = abs(tr);
   if (!(m < VOL_RR_TRANSMITTANCE)) return true;
-  if (rng_float(rng) * VOL_RR_TRANSMITTANCE >= m) return false;
+  if (u * VOL_RR_TRANSMITTANCE >= m) return false;
   tr = tr < 0.0f ? -VOL_RR_TRANSMITTANCE : VOL_RR_TRANSMITTANCE;
   return true;
 }
@@ -324,7 +328,7 @@ vec2 vol_fine_and_mean(uint v, float scale, vec3 p, float exactBound) {
 // value `value`, in volume v of density scale `scale`; u is a uniform number drawn with the step;
 // exactBound: the walk's (VolWalk.exactBound, for SAMPLE).
 void vol_track_event(uint tracker, inout VolTrack s, uint v, float scale, vec3 p, float t, float mu, vec2 value,
-                     float u, float exactBound, inout RngState rng) {
+                     float u, float exactBound) {
   if (tracker == VOL_TRACK_DELTA) {
     if (u * mu < scale * vol_density(v, p)) {
       s.t = t;
@@ -333,7 +337,7 @@ void vol_track_event(uint tracker, inout VolTrack s, uint v, float scale, vec3 p
     }
   } else if (tracker == VOL_TRACK_RATIO) {
     s.value *= max(0.0f, 1.0f - scale * vol_density(v, p) / mu);
-    if (!vol_transmittance_roulette(s.value, rng)) {
+    if (!vol_transmittance_roulette(s.value, u)) {
       s.value = 0.0f;
       s.stop = true;
     }
@@ -377,7 +381,7 @@ void vol_track_event(uint tracker, inout VolTrack s, uint v, float scale, vec3 p
     float sigma = scale * vol_density(v, p);
     s.emitted += (s.value * sigma / mu) * vol_emitted_radiance(v, p);
     s.value *= max(0.0f, 1.0f - sigma / mu);
-    if (!vol_transmittance_roulette(s.value, rng)) {
+    if (!vol_transmittance_roulette(s.value, u)) {
       s.value = 0.0f;
       s.stop = true;
     }
@@ -395,8 +399,8 @@ void vol_track_event(uint tracker, inout VolTrack s, uint v, float scale, vec3 p
 
 // One draw of the next tentative collision: h (h.y: the event's u) and the optical depth tau ~
 // Exp(1) to it; false where the step cap ends the walk (s.stop).
-bool vol_draw_depth(inout VolTrack s, inout uint steps, inout RngState rng, out uvec4 h, out float tau VOL_KC_PARAM) {
-  h = uvec4(0u);
+bool vol_draw_depth(inout VolTrack s, inout uint steps, inout RngWalk g, out uvec2 h, out float tau VOL_KC_PARAM) {
+  h = uvec2(0u);
   tau = 0.0f;
   if (++steps > VOL_MAX_STEPS) {
     s.stop = true;
@@ -405,7 +409,8 @@ bool vol_draw_depth(inout VolTrack s, inout uint steps, inout RngState rng, out 
 #ifdef PLUME_KERNEL_COUNTERS
   vol_kc_step(kc);
 #endif
-  h = rng_next4(rng);
+  h.x = rng_walk_next(g);
+  h.y = rng_walk_next(g);
   tau = -log(1.0f - rng_to_float(h.x));
   return true;
 }
@@ -422,7 +427,7 @@ bool vol_draw_depth(inout VolTrack s, inout uint steps, inout RngState rng, out 
 // the tracking loop from 3.0 to 4.1 of 8 (notes/bench/kernels.md "Session 21"). The mean field:
 // below.
 void vol_track_by_collision(uint tracker, uint v, inout VolTrack s, inout VolWalk w, float scale, vec3 o,
-                            vec3 d, inout uint steps, inout RngState rng VOL_KC_PARAM) {
+                            vec3 d, inout uint steps, inout RngWalk g VOL_KC_PARAM) {
   float a = 0.0f;
   float b = 0.0f;  // the current segment [a, b) (none yet: the first is entered below)
   vec2 value = vec2(0.0f);
@@ -431,9 +436,9 @@ void vol_track_by_collision(uint tracker, uint v, inout VolTrack s, inout VolWal
   for (;;) {
     // The next tentative collision: an optical depth tau ~ Exp(1) of the process of rate mu from
     // t on, spent across segments (one draw per tentative collision, not one per segment as well).
-    uvec4 h;
+    uvec2 h;
     float tau;
-    if (!vol_draw_depth(s, steps, rng, h, tau VOL_KC_ARG)) break;
+    if (!vol_draw_depth(s, steps, g, h, tau VOL_KC_ARG)) break;
     bool found = false;
     for (;;) {
       float left = mu * (b - t);  // the optical depth left in the current segment
@@ -455,7 +460,7 @@ void vol_track_by_collision(uint tracker, uint v, inout VolTrack s, inout VolWal
 #ifdef PLUME_KERNEL_COUNTERS
     vol_kc_lookup(kc);
 #endif
-    vol_track_event(tracker, s, v, scale, o + t * d, t, mu, value, rng_to_float(h.y), w.exactBound, rng);
+    vol_track_event(tracker, s, v, scale, o + t * d, t, mu, value, rng_to_float(h.y), w.exactBound);
     if (s.stop) break;
   }
 }
@@ -551,7 +556,7 @@ const uint VOL_PENDING_NONE = 0u;
 const uint VOL_PENDING_EXACT = 1u;  // an exact voxel over [a, b)
 const uint VOL_PENDING_EVENT = 2u;  // a tentative collision at t
 void vol_track_mean_residual(uint tracker, uint v, inout VolTrack s, inout VolWalk w, float scale, vec3 o, vec3 d,
-                             inout uint steps, inout RngState rng VOL_KC_PARAM) {
+                             inout uint steps, inout RngWalk g VOL_KC_PARAM) {
   bool innerLive = false;
   uint pending = VOL_PENDING_NONE;
   bool draw = true;  // the next tentative collision's optical depth is to be drawn
@@ -561,7 +566,7 @@ void vol_track_mean_residual(uint tracker, uint v, inout VolTrack s, inout VolWa
   float mu = 0.0f;   // the residual's rate in [a, b)
   float t = 0.0f;    // [t, b) is what is left of the current voxel
   float tau = 0.0f;  // the optical depth to the next tentative collision
-  uvec4 h = uvec4(0u);
+  uvec2 h = uvec2(0u);
   for (;;) {
     if (pending == VOL_PENDING_EXACT) {
       vol_track_exact(tracker, s, w, scale, a, b);  // the residual is 0 there: tau carries over
@@ -569,13 +574,13 @@ void vol_track_mean_residual(uint tracker, uint v, inout VolTrack s, inout VolWa
 #ifdef PLUME_KERNEL_COUNTERS
       vol_kc_lookup(kc);
 #endif
-      vol_track_event(tracker, s, v, scale, o + t * d, t, mu, value, rng_to_float(h.y), w.exactBound, rng);
+      vol_track_event(tracker, s, v, scale, o + t * d, t, mu, value, rng_to_float(h.y), w.exactBound);
       if (s.stop) break;
       draw = true;
     }
     pending = VOL_PENDING_NONE;
     if (draw) {
-      if (!vol_draw_depth(s, steps, rng, h, tau VOL_KC_ARG)) break;
+      if (!vol_draw_depth(s, steps, g, h, tau VOL_KC_ARG)) break;
       draw = false;
     }
     if (!vol_track_alive(tracker, s)) break;
@@ -615,10 +620,13 @@ void vol_track_mean_residual(uint tracker, uint v, inout VolTrack s, inout VolWa
 }
 #endif
 // The walk. `init`: the tracker's starting value (RATIO, RESIDUAL, RESIDUAL_RATIO 1; TAU 0;
-// DELTA, SAMPLE unused). Each tentative collision of the majorant's (or the residual's) Poisson
-// process draws one rng_next4: its x the optical depth Exp(1) to it from the last one, spent
-// across segments of different rates (the inverse of the piecewise-linear optical depth), its y
-// the event's u.
+// DELTA, SAMPLE unused). A walk that draws takes one rng_next4 of the stream as the state of its
+// own generator (rng_walk_init, shared/rng.h: xoshiro128+, a few shifts and xors per number
+// instead of a pcg4d's chain of multiplies; the bundled smoke's path tracer ~10% faster, its
+// shading kernel ~18%); each tentative collision of the majorant's (or the residual's) Poisson
+// process takes two numbers of it: the optical depth Exp(1) to it from the last one, spent across
+// segments of different rates (the inverse of the piecewise-linear optical depth), and the
+// event's u (ratio tracking's roulette reads it: vol_transmittance_roulette).
 VolTrack vol_track(uint tracker, uint v, vec3 xWorld, vec3 wWorld, float tMax, float init, inout RngState rng) {
   VolTrack s;
   s.value = init;
@@ -640,12 +648,16 @@ VolTrack vol_track(uint tracker, uint v, vec3 xWorld, vec3 wWorld, float tMax, f
   VolKc kc = vol_kc_start();
 #endif
   float scale = vol_scale(v);  // sigma_t = scale * d, read once per walk
+  // The walk's own generator, one draw of the stream (the mean field's optical depth draws none).
+  RngWalk g;
+  g.s = uvec4(0u);
+  if (tracker != VOL_TRACK_TAU) g = rng_walk_init(rng);
   if (field == VOL_FIELD_MAJORANT) {
-    vol_track_by_collision(tracker, v, s, w, scale, o, d, steps, rng VOL_KC_ARG);
+    vol_track_by_collision(tracker, v, s, w, scale, o, d, steps, g VOL_KC_ARG);
   } else {
 #if defined(PLUME_VOL_MEAN_FIELD) || defined(PLUME_VOL_PREVIOUS)
     if (tracker == VOL_TRACK_RESIDUAL) {
-      vol_track_mean_residual(tracker, v, s, w, scale, o, d, steps, rng VOL_KC_ARG);
+      vol_track_mean_residual(tracker, v, s, w, scale, o, d, steps, g VOL_KC_ARG);
     } else {
       vol_track_mean_closed(tracker, s, w, scale VOL_KC_ARG);
     }

@@ -180,16 +180,14 @@ double meanRatio(std::span<const float> a, std::span<const float> b) {
 
 // --- Z-tests ---------------------------------------------------------------------------------
 namespace {
-// z for one channel test; +-inf for a mismatch where the variance is 0 or a non-finite input.
+// z for one channel test (finite: the precision floors), +inf for a non-finite input.
 double channelZ(double a, double b, double variance) {
   if (!std::isfinite(a) || !std::isfinite(b) || !std::isfinite(variance) || variance < 0.0) {
     return std::numeric_limits<double>::infinity();
   }
-  const double floor = kZTestRelativePrecision * std::max(std::abs(a), std::abs(b));
-  variance += floor * floor;
-  if (variance == 0.0) {  // both exactly 0
-    return a == b ? 0.0 : (a > b ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity());
-  }
+  const double floor =
+      std::max(kZTestRelativePrecision * std::max(std::abs(a), std::abs(b)), kZTestAbsolutePrecision);
+  variance += floor * floor;  // > 0: the absolute floor
   return (a - b) / std::sqrt(variance);
 }
 
