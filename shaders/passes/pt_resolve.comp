@@ -20,7 +20,8 @@ void main() {
   scene_load_params();
   uint i = gl_GlobalInvocationID.x;
   if (i >= ptPush.pixelCount) return;
-  uint index = ptPush.pixelBegin + i;
+  uvec2 pixel = pt_list_pixel(ptPush.pixelBegin + i);
+  uint index = pixel.y * frame.size.x + pixel.x - ptPush.accumBase;
   vec4 a = ptAccum[2u * index];
   vec3 m2a = ptAccum[2u * index + 1u].rgb;
   for (uint slot = i; slot < ptPush.slots; slot += ptPush.pixelCount) {

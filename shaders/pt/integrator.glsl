@@ -122,10 +122,13 @@ vec3 pt_escaped_map(vec3 dir, float phasePdf) {
 
 // The camera ray of the path in `slot`: its first two draws (a box filter over the pixel, row 0
 // at the top: DESIGN §2).
+vec3 pt_pixel_ray(uvec2 pixel, inout RngState rng) {
+  return normalize(cam_direction(vec2(pixel) + rng_float2(rng), frame.size, frame.camera));
+}
 vec3 pt_camera_ray(uint slot, inout RngState rng) {
   uvec2 pixel;
   pt_slot_sample(slot, pixel);
-  return normalize(cam_direction(vec2(pixel) + rng_float2(rng), frame.size, frame.camera));
+  return pt_pixel_ray(pixel, rng);
 }
 
 // The camera kernel (pt_camera.comp): true where the path in `slot`'s camera ray may meet the

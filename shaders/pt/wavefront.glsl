@@ -112,18 +112,31 @@ void pt_store_ray(uint slot, PtPath p) {
   ptPaths[slot].beta = p.beta;
 }
 
+// The frame's pixels in the kernels' order (shared/pt_wave.h), packed x | y << 16; without a
+// list (ptPush.listed 0: an image whose accumulation is split, in row order) entry i is pixel i.
+layout(binding = BIND_PT_PIXELS) uniform usamplerBuffer ptPixels;
+uvec2 pt_list_pixel(uint entry) {
+  if (ptPush.listed == 0u) return uvec2(entry % frame.size.x, entry / frame.size.x);
+  uint packed = texelFetch(ptPixels, int(entry)).r;
+  return uvec2(packed & 0xffffu, packed >> 16u);
+}
+
 // The pixel of a slot, and the index of its sample in the frame.
 uint pt_slot_sample(uint slot, out uvec2 pixel) {
-  uint p = ptPush.pixelBegin + slot % ptPush.pixelCount;
-  pixel = uvec2(p % frame.size.x, p / frame.size.x);
+  pixel = pt_list_pixel(ptPush.pixelBegin + slot % ptPush.pixelCount);
   return frame.firstSample + ptPush.sampleBase + slot / ptPush.pixelCount;
+}
+
+// The random stream of sample `sampleIndex` of a pixel (DESIGN §2).
+RngState pt_sample_rng(uvec2 pixel, uint sampleIndex) {
+  return rng_init(pixel, frame.frameKey, RNG_STREAM_PATH + (sampleIndex << 8u), frame.seed);
 }
 
 // The slot's random stream at draw `counter` (the stream of sample s of a pixel: DESIGN §2).
 RngState pt_slot_rng(uint slot, uint counter) {
   uvec2 pixel;
   uint sampleIndex = pt_slot_sample(slot, pixel);
-  RngState rng = rng_init(pixel, frame.frameKey, RNG_STREAM_PATH + (sampleIndex << 8u), frame.seed);
+  RngState rng = pt_sample_rng(pixel, sampleIndex);
   rng.counter = counter;
   return rng;
 }

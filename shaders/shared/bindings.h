@@ -25,6 +25,7 @@ const uint BIND_PT_PATHS = 8u;         // per path slot: PT_PATH_TEXELS uvec4 te
 const uint BIND_PT_QUEUES = 9u;        // uint[2 * slots]: the paths to extend, then those to shade
 const uint BIND_PT_WAVE = 10u;         // PtWave: queue lengths and the indirect dispatches
 const uint BIND_PT_PATH_TEXELS = 15u;  // the path slots again, read as a uniform texel buffer
+const uint BIND_PT_PIXELS = 16u;       // uint[]: the pixel list, packed x | y << 16 (render/pixel_order.h)
 
 // The scene's surfaces (shaders/surface/surfaces.glsl; render/gpu_surfaces.cpp), in the
 // estimators that render them (PLUME_HAS_SURFACES).

@@ -70,6 +70,7 @@ class TexelBuffer {
   VkBufferView view() const { return view_; }
   const Buffer& buffer() const { return buffer_; }
   void fillZero() { buffer_.fillZero(); }
+  void upload(const void* data, size_t bytes) { buffer_.upload(data, bytes); }  // from the first texel
 
  private:
   void release();

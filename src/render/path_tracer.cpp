@@ -71,12 +71,21 @@ PathTracer::PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const S
                            "path slots", true);
   queues_ = gpu::Buffer(ctx, size_t(slots_) * 2 * sizeof(uint32_t), storage, "path queues");
   wave_ = gpu::Buffer(ctx, sizeof(shared::PtWave), storage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, "path queue lengths");
+  // The pixel list, ordered by each frame's first addSamples (orderPixels); only with the
+  // background pass (an image of one accumulation buffer, far below the texel limit).
+  const bool background = !features_.surfaces && accums_.size() == 1;
+  pixelList_ = gpu::TexelBuffer(ctx, nullptr, background ? std::max<size_t>(pixels, 1) : 1, VK_FORMAT_R32_UINT,
+                                "pixel list");
   const gpu::ShaderDefines none;
   queue_ = makePass("passes/pt_queue.comp", none, "pt queues", false);
   for (const gpu::Buffer& band : accums_) {
     resolves_.push_back(makePass("passes/pt_resolve.comp", none, "pt resolve", false));
     resolves_.back()->set.bind(shared::BIND_PT_ACCUM, band);
   }
+  // The background pass: a camera ray that can only miss sees the environment; with surfaces
+  // every ray may meet the scene. One accumulation buffer only (a split one keeps its bands in
+  // row order: path_tracer.h orderPixels).
+  if (background) background_ = makePass("passes/pt_background.comp", features_.defines(), "pt background", true);
   active_ = &tracking(false);
 }
 
@@ -84,6 +93,7 @@ PathTracer::PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const S
 gpu::BindingTypes PathTracer::volumeTypes() const {
   gpu::BindingTypes types = sceneBindingTypes(false, features_.emission, features_.surfaces, 0);
   types.emplace_back(shared::BIND_PT_PATH_TEXELS, gpu::BindingType::TexelBuffer);
+  types.emplace_back(shared::BIND_PT_PIXELS, gpu::BindingType::TexelBuffer);
   return types;
 }
 
@@ -96,8 +106,9 @@ std::unique_ptr<gpu::ComputePass> PathTracer::makePass(const std::string& file, 
   // the volume's images are in the tables of the kernels that walk it, the emission atlas only
   // where the scene emits.
   std::vector<BindingType> table =
-      !volumeTable ? gpu::bindingTable(shared::BIND_PT_PATH_TEXELS + 1,
-                                       {{shared::BIND_PT_PATH_TEXELS, gpu::BindingType::TexelBuffer}})
+      !volumeTable ? gpu::bindingTable(shared::BIND_PT_PIXELS + 1,
+                                       {{shared::BIND_PT_PATH_TEXELS, gpu::BindingType::TexelBuffer},
+                                        {shared::BIND_PT_PIXELS, gpu::BindingType::TexelBuffer}})
       : gpu::bindingTable(features_.emission ? shared::BIND_BLACKBODY + 1 : shared::BIND_ENV_MAP + 1, volumeTypes());
   auto pass = std::make_unique<gpu::ComputePass>(ctx_, compiler_.compile(file, all), std::move(table),
                                                  uint32_t(sizeof(shared::PtPush)), name,
@@ -106,6 +117,7 @@ std::unique_ptr<gpu::ComputePass> PathTracer::makePass(const std::string& file, 
   pass->set.bind(shared::BIND_PT_ACCUM, accums_[0]);  // the resolve passes rebind their band
   pass->set.bind(shared::BIND_PT_PATHS, paths_.buffer());
   pass->set.bind(shared::BIND_PT_PATH_TEXELS, paths_);
+  pass->set.bind(shared::BIND_PT_PIXELS, pixelList_);
   pass->set.bind(shared::BIND_PT_QUEUES, queues_);
   pass->set.bind(shared::BIND_PT_WAVE, wave_);
   if (volumeTable) {
@@ -140,6 +152,24 @@ void PathTracer::setVolume(const GpuVolumeResources& volume) {
   volume.bind(active_->camera->set);
   volume.bind(active_->extend->set);
   volume.bind(active_->shade->set);
+  if (background_) volume.bind(background_->set);
+  footprint_ = volume.footprint();
+  volumeSerial_ = volume.serial();
+}
+
+void PathTracer::orderPixels() {
+  if (ordered_ && sameCamera(orderCam_, frame_.camera) && orderSerial_ == volumeSerial_) return;
+  const int w = scene_.camera.width, h = scene_.camera.height;
+  if (background_) {
+    order_ = volumePixelOrder(frame_.camera, w, h, footprint_);
+    pixelList_.upload(order_.pixels.data(), order_.pixels.size() * sizeof(uint32_t));
+  } else {
+    order_.pixels.clear();  // row order, all inside: no list (PtPush::listed 0)
+    order_.inside = uint32_t(size_t(w) * size_t(h));
+  }
+  orderCam_ = frame_.camera;
+  orderSerial_ = volumeSerial_;
+  ordered_ = true;
 }
 
 void PathTracer::beginFrame(int frame) {
@@ -166,6 +196,7 @@ void PathTracer::traceGeneration(uint32_t pixelBegin, uint32_t pixels, uint32_t 
   shared::PtPush push{};
   push.pixelBegin = pixelBegin;
   push.pixelCount = pixels;
+  push.listed = background_ ? 1u : 0u;
   push.sampleBase = sampleBase;
   push.slots = pixels * samples;
   PLUME_CHECK(push.slots <= slots_);
@@ -213,10 +244,11 @@ void PathTracer::traceGeneration(uint32_t pixelBegin, uint32_t pixels, uint32_t 
     // A path still queued after max_bounces + 1 extensions would be a bug in the kernels.
     PLUME_CHECK_MSG(extensions < maxExtensions, "path tracer: paths left after max_bounces + 1 extensions");
   }
-  // The accumulation buffer that holds these pixels, indexed from its first.
-  const uint32_t part = pixelBegin / accumPixels_;
-  PLUME_CHECK(part < accums_.size() && (pixelBegin + pixels - 1) / accumPixels_ == part);
-  push.pixelBegin = pixelBegin - part * accumPixels_;
+  // The accumulation buffer that holds these pixels, indexed from its first (a split one's list is
+  // in row order, so its entries are its pixel indices: orderPixels).
+  const uint32_t part = accums_.size() == 1 ? 0u : pixelBegin / accumPixels_;
+  PLUME_CHECK(part < accums_.size() && (accums_.size() == 1 || (pixelBegin + pixels - 1) / accumPixels_ == part));
+  push.accumBase = part * accumPixels_;
   ctx_.submitAndWait([&](VkCommandBuffer cmd) {
     timer_.reset(cmd);
     resolves_[part]->record(cmd, glm::uvec3(pixels, 1, 1), &push, &timer_);
@@ -230,7 +262,8 @@ void PathTracer::traceGeneration(uint32_t pixelBegin, uint32_t pixels, uint32_t 
 void PathTracer::addSamples(int spp) {
   frame_.firstSample = uint32_t(samples_);
   frameBuffer_.upload(&frame_, sizeof(frame_));
-  const uint32_t pixels = uint32_t(scene_.camera.width) * uint32_t(scene_.camera.height);
+  orderPixels();
+  const uint32_t pixels = order_.inside;
   passTimes_.clear();
   for (uint32_t done = 0; done < uint32_t(spp);) {
     const uint32_t n = std::min(uint32_t(spp) - done, samplesPerGeneration());
@@ -238,6 +271,26 @@ void PathTracer::addSamples(int spp) {
       traceGeneration(begin, std::min(bandPixels_, pixels - begin), done, n);
     }
     done += n;
+  }
+  // The pixels whose every ray misses the scene: their samples in chunks far below the driver's
+  // loop budget (volume/loop_guard.glsl), in sample order.
+  const uint32_t outside = background_ ? uint32_t(order_.pixels.size()) - order_.inside : 0u;
+  if (background_ && outside > 0) {
+    constexpr uint32_t kBackgroundSamples = 4096;
+    for (uint32_t done = 0; done < uint32_t(spp); done += kBackgroundSamples) {
+      shared::PtPush push{};
+      push.pixelBegin = order_.inside;
+      push.pixelCount = outside;
+      push.sampleBase = done;
+      push.slots = std::min(kBackgroundSamples, uint32_t(spp) - done);
+      push.accumBase = 0;
+      push.listed = 1;
+      ctx_.submitAndWait([&](VkCommandBuffer cmd) {
+        timer_.reset(cmd);
+        background_->record(cmd, glm::uvec3(outside, 1, 1), &push, &timer_);
+      });
+      addTimes();
+    }
   }
   samples_ += spp;
 }

@@ -13,6 +13,7 @@
 #include "render/gpu_envmap.h"
 #include "render/gpu_surfaces.h"
 #include "render/gpu_volume.h"
+#include "render/pixel_order.h"
 #include "scene/scene.h"
 
 #include <memory>
@@ -84,6 +85,19 @@ class PathTracer {
   Tracking* active_ = nullptr;
   std::unique_ptr<gpu::ComputePass> queue_;
   std::vector<std::unique_ptr<gpu::ComputePass>> resolves_;  // one per accumulation band
+  // The pixels whose every camera ray misses the scene (the end of the pixel list), finished
+  // without slots; only where the scene has no surfaces and the accumulation is one buffer.
+  std::unique_ptr<gpu::ComputePass> background_;
+  // The pixel list (render/pixel_order.h): the pixels whose rays may meet the volume first, in
+  // tile order, then the others; without a background pass no list (row order, all inside).
+  // Rebuilt when the camera or the volume changes.
+  void orderPixels();
+  bool ordered_ = false;
+  VolumeFootprint footprint_;
+  uint64_t volumeSerial_ = 0, orderSerial_ = 0;
+  shared::GpuCamera orderCam_{};
+  PixelOrder order_;
+  gpu::TexelBuffer pixelList_;
   bool skipEmpty_ = false;
   gpu::GpuTimer timer_;
   gpu::Buffer frameBuffer_;
