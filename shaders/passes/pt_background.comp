@@ -30,11 +30,18 @@ void main() {
   uint index = pixel.y * frame.size.x + pixel.x - ptPush.accumBase;
   vec4 a = ptAccum[2u * index];
   vec3 m2a = ptAccum[2u * index + 1u].rgb;
+#ifdef PLUME_HAS_ENV_MAP
   // ptPush.slots samples (the host keeps it far below the driver's loop budget).
   for (uint s = 0u; s < ptPush.slots; ++s) {
     RngState rng = pt_sample_rng(pixel, frame.firstSample + ptPush.sampleBase + s);
     acc_merge(a, m2a, light_escaped(pt_pixel_ray(pixel, rng)), vec3(0.0f), 1.0f);
   }
+#else
+  // Without a map the environment does not depend on the ray's direction: the samples are
+  // ptPush.slots copies of one value, merged at once (the same bits as one at a time, since every
+  // earlier sample of the pixel in this frame had that value too: shared/accumulate.h).
+  acc_merge(a, m2a, light_escaped(vec3(0.0f, 0.0f, 1.0f)), vec3(0.0f), float(ptPush.slots));
+#endif
   ptAccum[2u * index] = a;
   ptAccum[2u * index + 1u] = vec4(m2a, 0.0f);
 }
