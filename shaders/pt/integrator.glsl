@@ -120,8 +120,8 @@ vec3 pt_escaped_map(vec3 dir, float phasePdf) {
 #define PT_FOLLOWS_PHASE 1
 #endif
 
-// The camera ray of the path in `slot`: its first two draws (a box filter over the pixel, row 0
-// at the top: DESIGN §2).
+// The camera ray of a sample of `pixel` (pt_background's), or of the path in `slot`: the stream's
+// first two draws (a box filter over the pixel, row 0 at the top: DESIGN §2).
 vec3 pt_pixel_ray(uvec2 pixel, inout RngState rng) {
   return normalize(cam_direction(vec2(pixel) + rng_float2(rng), frame.size, frame.camera));
 }

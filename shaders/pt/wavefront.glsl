@@ -57,8 +57,8 @@ vec3 pt_xyz(uvec4 t) { return uintBitsToFloat(t.xyz); }
 vec3 pt_radiance(uint slot) { return ptPaths[slot].radiance; }
 void pt_set_radiance(uint slot, vec3 radiance) { ptPaths[slot].radiance = radiance; }
 
-layout(std430, binding = BIND_PT_QUEUES) buffer QueueBuffer { uint ptQueues[]; };
 // [0, slots): the paths to extend; [slots, 2 slots): the paths to shade.
+layout(std430, binding = BIND_PT_QUEUES) buffer QueueBuffer { uint ptQueues[]; };
 layout(std430, binding = BIND_PT_WAVE) buffer WaveBuffer { PtWave wave; };
 layout(push_constant) uniform PtPushBlock { PtPush ptPush; };
 

@@ -72,10 +72,10 @@ constexpr double kZTestAlpha = 0.01;  // family-wise level over all pixels and c
 // that the other renderer grazed): neither may turn the test into an exact-equality check.
 constexpr double kZTestRelativePrecision = 1e-4;
 // And an absolute one: a difference below the smallest normal float is rounding too. Denormal
-// radiance (a blackbody's red tail at a few hundred kelvin reaches 1e-44) is flushed to 0 by
-// devices that flush denormals (Vulkan allows it) and its square underflows in the float variance
-// accumulators, so a denormal against an exact 0 with no variance is no evidence of a bias
-// (without this floor such a pixel read z = 1e4).
+// radiance (session 28: a pixel of the Blender fire read 1.68e-44 in red on the GPU, exactly 0 in
+// the reference) is flushed to 0 by devices that flush denormals (Vulkan allows it) and its square
+// underflows in the float variance accumulators, so a denormal against an exact 0 with no
+// variance is no evidence of a bias (without this floor such a pixel read z = 1e4).
 constexpr double kZTestAbsolutePrecision = 1.17549435e-38;  // FLT_MIN
 
 struct ZTestResult {
