@@ -468,9 +468,10 @@ void vol_track_by_collision(uint tracker, uint v, inout VolTrack s, inout VolWal
 #if defined(PLUME_VOL_MEAN_FIELD) || defined(PLUME_VOL_PREVIOUS)
 // The mean field's walks, in nested loops: the voxel loop holds only a mean-field read, the
 // tracker's closed form for the voxel and, for RESIDUAL, the draws of its tentative collisions;
-// it leaves for the rare work, which the outer loop does: a new brick (the indirection read and
-// the voxel DDA's set-up; empty bricks in their own tight loop), an exact voxel (8 texel reads,
-// Gauss-Legendre) and a tentative collision's density lookup. As one loop over segments
+// it leaves for the rare work, which the loops around it do: a new brick (the indirection read
+// and the voxel DDA's set-up; empty bricks in their own tight loop) and a tentative collision's
+// density lookup in the brick loop, an exact voxel (8 texel reads, Gauss-Legendre) in the
+// outermost loop, the rarest. As one loop over segments
 // (vol_walk_next), every voxel paid for all three on lavapipe: ReSTIR's candidates ran 3.7x and
 // its spatial reuse 2.2x slower (notes/bench/kernels.md, "Session 14"). The same segments in the
 // same order, so the same results to the bit.
@@ -516,36 +517,41 @@ bool vol_mean_next_voxel(inout VolWalk w, out float a, out float b, out vec2 val
   return true;
 }
 
-// The closed-form tracker (TAU: no draws).
+// The closed-form tracker (TAU: no draws). An exact voxel leaves both loops for the outermost
+// one, which integrates it: a SIMD back end runs that loop's body once per walk and exact voxel
+// met by any lane, instead of once per brick entered (in the brick loop every brick paid the
+// exact voxel's 8 texel reads, masked, ~12% of a ReSTIR iteration on the bundled smoke: a perf
+// profile, notes/bench/kernels.md "Session 29"). The same segments in the same order, so the
+// same bits.
 void vol_track_mean_closed(uint tracker, inout VolTrack s, inout VolWalk w, float scale VOL_KC_PARAM) {
   bool innerLive = false;
-  bool pending = false;  // an exact voxel [a, b) waits for the outer loop
   float a = 0.0f;
   float b = 0.0f;
   for (;;) {
-    if (pending) {
-      pending = false;
-      vol_track_exact(tracker, s, w, scale, a, b);
-      if (!vol_track_alive(tracker, s)) break;
-    }
-    if (!innerLive) {
-      if (!vol_mean_enter_brick(w)) break;
-      innerLive = true;
-    }
+    bool pending = false;  // an exact voxel [a, b) waits for this loop
     for (;;) {
-      vec2 value;
-      if (!vol_mean_next_voxel(w, a, b, value, pending)) {
-        innerLive = false;
-        break;
+      if (!innerLive) {
+        if (!vol_mean_enter_brick(w)) break;
+        innerLive = true;
       }
+      for (;;) {
+        vec2 value;
+        if (!vol_mean_next_voxel(w, a, b, value, pending)) {
+          innerLive = false;
+          break;
+        }
 #ifdef PLUME_KERNEL_COUNTERS
-      vol_kc_segment(kc);
+        vol_kc_segment(kc);
 #endif
-      if (pending) break;
-      vol_track_segment(tracker, s, a, b, value);
-      if (!vol_track_alive(tracker, s)) break;
+        if (pending) break;
+        vol_track_segment(tracker, s, a, b, value);
+        if (!vol_track_alive(tracker, s)) break;
+      }
+      if (pending || !vol_track_alive(tracker, s)) break;
     }
-    if (!pending && !vol_track_alive(tracker, s)) break;
+    if (!pending) break;
+    vol_track_exact(tracker, s, w, scale, a, b);
+    if (!vol_track_alive(tracker, s)) break;
   }
 }
 
@@ -567,58 +573,65 @@ void vol_track_mean_residual(uint tracker, uint v, inout VolTrack s, inout VolWa
   float t = 0.0f;    // [t, b) is what is left of the current voxel
   float tau = 0.0f;  // the optical depth to the next tentative collision
   uvec2 h = uvec2(0u);
+  // Exact voxels in the outermost loop, as vol_track_mean_closed's; tentative collisions and
+  // bricks in the middle one.
   for (;;) {
-    if (pending == VOL_PENDING_EXACT) {
-      vol_track_exact(tracker, s, w, scale, a, b);  // the residual is 0 there: tau carries over
-    } else if (pending == VOL_PENDING_EVENT) {
-#ifdef PLUME_KERNEL_COUNTERS
-      vol_kc_lookup(kc);
-#endif
-      vol_track_event(tracker, s, v, scale, o + t * d, t, mu, value, rng_to_float(h.y), w.exactBound);
-      if (s.stop) break;
-      draw = true;
-    }
-    pending = VOL_PENDING_NONE;
-    if (draw) {
-      if (!vol_draw_depth(s, steps, g, h, tau VOL_KC_ARG)) break;
-      draw = false;
-    }
-    if (!vol_track_alive(tracker, s)) break;
-    if (!innerLive) {
-      if (!vol_mean_enter_brick(w)) break;
-      innerLive = true;
-    }
     for (;;) {
-      float left = mu * (b - t);
-      if (tau < left) {
-        t += tau / mu;
-        pending = VOL_PENDING_EVENT;
-        break;
-      }
-      tau -= left;
-      t = b;
-      bool exact;
-      if (!vol_track_alive(tracker, s)) break;
-      if (!vol_mean_next_voxel(w, a, b, value, exact)) {
-        innerLive = false;
-        break;
-      }
+      if (pending == VOL_PENDING_EVENT) {
 #ifdef PLUME_KERNEL_COUNTERS
-      vol_kc_segment(kc);
+        vol_kc_lookup(kc);
 #endif
-      if (exact) {
-        mu = 0.0f;
-        t = b;
-        pending = VOL_PENDING_EXACT;
-        break;
+        vol_track_event(tracker, s, v, scale, o + t * d, t, mu, value, rng_to_float(h.y), w.exactBound);
+        if (s.stop) break;
+        draw = true;
       }
-      mu = vol_track_segment(tracker, s, a, b, value);
-      t = a;
+      pending = VOL_PENDING_NONE;
+      if (draw) {
+        if (!vol_draw_depth(s, steps, g, h, tau VOL_KC_ARG)) break;
+        draw = false;
+      }
+      if (!vol_track_alive(tracker, s)) break;
+      if (!innerLive) {
+        if (!vol_mean_enter_brick(w)) break;
+        innerLive = true;
+      }
+      for (;;) {
+        float left = mu * (b - t);
+        if (tau < left) {
+          t += tau / mu;
+          pending = VOL_PENDING_EVENT;
+          break;
+        }
+        tau -= left;
+        t = b;
+        bool exact;
+        if (!vol_track_alive(tracker, s)) break;
+        if (!vol_mean_next_voxel(w, a, b, value, exact)) {
+          innerLive = false;
+          break;
+        }
+#ifdef PLUME_KERNEL_COUNTERS
+        vol_kc_segment(kc);
+#endif
+        if (exact) {
+          mu = 0.0f;
+          t = b;
+          pending = VOL_PENDING_EXACT;
+          break;
+        }
+        mu = vol_track_segment(tracker, s, a, b, value);
+        t = a;
+      }
+      if (pending == VOL_PENDING_EXACT) break;
+      if (pending == VOL_PENDING_NONE && (innerLive || !vol_track_alive(tracker, s))) break;
     }
-    if (pending == VOL_PENDING_NONE && (innerLive || !vol_track_alive(tracker, s))) break;
+    if (pending != VOL_PENDING_EXACT) break;
+    vol_track_exact(tracker, s, w, scale, a, b);  // the residual is 0 there: tau carries over
+    pending = VOL_PENDING_NONE;
   }
 }
 #endif
+
 // The walk. `init`: the tracker's starting value (RATIO, RESIDUAL, RESIDUAL_RATIO 1; TAU 0;
 // DELTA, SAMPLE unused). A walk that draws takes one rng_next4 of the stream as the state of its
 // own generator (rng_walk_init, shared/rng.h: xoshiro128+, a few shifts and xors per number
