@@ -21,16 +21,31 @@ struct DdaState {
   ivec3 dims;
 };
 
-// Clips [tMin, tMax] to the grid [origin, origin + dims * cellSize] and sets up the walk.
-// Returns false when the ray misses the grid.
-PLUME_FN bool dda_init(OUT(DdaState) s, vec3 o, vec3 d, float tMin, float tMax, vec3 origin,
-                       float cellSize, ivec3 dims) {
-  s.dims = dims;
+// The per-axis constants of a walk along d over cells of size cellSize (stepDir, tDelta): set
+// once per ray, then dda_enter (re)starts the walk in any grid of such cells. Walks that restart
+// a DDA at every brick (the mean field's voxels, the majorant bricks under a coarse cell) keep
+// these out of their loops, where a SIMD back end pays for every value a loop writes
+// (notes/bench/kernels.md "Session 29").
+PLUME_FN void dda_axes(INOUT(DdaState) s, vec3 d, float cellSize) {
+  for (int a = 0; a < 3; ++a) {
+    if (abs(d[a]) < 1e-30f) {
+      s.stepDir[a] = 0;
+      s.tDelta[a] = DDA_INF;
+    } else {
+      s.stepDir[a] = d[a] > 0.0f ? 1 : -1;
+      s.tDelta[a] = cellSize / abs(d[a]);
+    }
+  }
+}
+
+// Clips [tMin, tMax] to the grid [origin, origin + s.dims * cellSize] and starts the walk there
+// (s.dims and dda_axes's constants set before). Returns false when the ray misses the grid.
+PLUME_FN bool dda_enter(INOUT(DdaState) s, vec3 o, vec3 d, float tMin, float tMax, vec3 origin, float cellSize) {
   float t0 = tMin;
   float t1 = tMax;
   for (int a = 0; a < 3; ++a) {
     float lo = origin[a];
-    float hi = origin[a] + float(dims[a]) * cellSize;
+    float hi = origin[a] + float(s.dims[a]) * cellSize;
     if (abs(d[a]) < 1e-30f) {
       if (o[a] < lo || o[a] >= hi) t1 = -1.0f;
     } else {
@@ -45,19 +60,24 @@ PLUME_FN bool dda_init(OUT(DdaState) s, vec3 o, vec3 d, float tMin, float tMax, 
   if (!(t0 < t1)) return false;
   vec3 p = o + t0 * d;
   for (int a = 0; a < 3; ++a) {
-    s.cell[a] = clamp(int(floor((p[a] - origin[a]) / cellSize)), 0, dims[a] - 1);
+    s.cell[a] = clamp(int(floor((p[a] - origin[a]) / cellSize)), 0, s.dims[a] - 1);
     if (abs(d[a]) < 1e-30f) {
-      s.stepDir[a] = 0;
       s.tNext[a] = DDA_INF;
-      s.tDelta[a] = DDA_INF;
     } else {
-      s.stepDir[a] = d[a] > 0.0f ? 1 : -1;
       float boundary = origin[a] + float(s.cell[a] + (d[a] > 0.0f ? 1 : 0)) * cellSize;
       s.tNext[a] = (boundary - o[a]) / d[a];
-      s.tDelta[a] = cellSize / abs(d[a]);
     }
   }
   return true;
+}
+
+// Clips [tMin, tMax] to the grid [origin, origin + dims * cellSize] and sets up the walk.
+// Returns false when the ray misses the grid.
+PLUME_FN bool dda_init(OUT(DdaState) s, vec3 o, vec3 d, float tMin, float tMax, vec3 origin,
+                       float cellSize, ivec3 dims) {
+  s.dims = dims;
+  dda_axes(s, d, cellSize);
+  return dda_enter(s, o, d, tMin, tMax, origin, cellSize);
 }
 
 // The next segment [t0, t1) and its cell; false when the ray has left the grid. Written with

@@ -120,6 +120,7 @@ bool vol_walk_start(uint field, uint v, vec3 o, vec3 d, float tMax, out VolWalk 
     if (vol.empty != 0 || !vol_clip_to_bounds(vol.boundsMin, vol.boundsMax, o, d, tMax, t0, t1)) return false;
 #ifdef PLUME_SKIP_EMPTY
     if (vol.levelCount < 2u) return false;  // no level 1: a host bug
+    dda_axes(w.inner, d, float(VOL_BRICK));  // the bricks under a level-1 cell: vol_walk_next
     return dda_init(w.outer, o, d, t0, t1, vec3(vol.brickOrigin * VOL_BRICK),
                     float(VOL_BRICK * vol.levels[1].bricksPerCell), vol.levels[1].cells);
 #else
@@ -133,6 +134,8 @@ bool vol_walk_start(uint field, uint v, vec3 o, vec3 d, float tMax, out VolWalk 
   if (vol_is_empty(v) || !vol_clip_to_bounds(VOL_PARAM(v, boundsMin), VOL_PARAM(v, boundsMax), o, d, tMax, t0, t1))
     return false;
   w.scale = vol_scale(v);
+  w.inner.dims = ivec3(VOL_BRICK);  // a brick's voxels: vol_mean_enter_brick
+  dda_axes(w.inner, d, 1.0f);
   return dda_init(w.outer, o, d, t0, t1, vec3(VOL_PARAM(v, brickOrigin) * VOL_BRICK), float(VOL_BRICK),
                   VOL_PARAM(v, brickDims));
 }
@@ -166,9 +169,9 @@ bool vol_walk_next(inout VolWalk w, out float a, out float b, out vec2 value) {
     if (vol_level_max(1, cell) <= 0.0f) continue;
     int n = vol.levels[1].bricksPerCell;
     w.outerCell = cell;
-    ivec3 dims = min(ivec3(n), vol.levels[0].cells - cell * n);
-    w.innerLive = dda_init(w.inner, w.o, w.d, oa, ob, vec3((vol.brickOrigin + cell * n) * VOL_BRICK),
-                           float(VOL_BRICK), dims);
+    w.inner.dims = min(ivec3(n), vol.levels[0].cells - cell * n);
+    w.innerLive = dda_enter(w.inner, w.o, w.d, oa, ob, vec3((vol.brickOrigin + cell * n) * VOL_BRICK),
+                            float(VOL_BRICK));
   }
   return false;
 #endif
@@ -496,7 +499,7 @@ bool vol_mean_enter_brick(inout VolWalk w) {
     w.base = vol_mean_field_base(w.v, slot);
     w.brickVoxel = brick * VOL_BRICK;
     w.brickTexel = vol_slot_coords(slot) * VOL_TEXELS + 1;  // as vol_locate
-    if (dda_init(w.inner, w.o, w.d, oa, ob, vec3(brick * VOL_BRICK), 1.0f, ivec3(VOL_BRICK))) return true;
+    if (dda_enter(w.inner, w.o, w.d, oa, ob, vec3(brick * VOL_BRICK), 1.0f)) return true;
   }
   return false;
 }
