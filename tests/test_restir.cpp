@@ -325,7 +325,7 @@ void expectMovingCameraMatches(gpu::Context& ctx, gpu::ShaderCompiler& compiler,
 TEST_F(GpuRestir, MovingCameraMatchesReferencesOfItsPoses) {
   RestirOptions o;
   o.radius = 6;
-  o.historyCapMoving = 5;  // as the bundled city (GpuRestirSurfaces' moving test keeps c 20)
+  o.historyCapMoving = 5;  // as the bundled city (GpuRestirSurfaces' moving test keeps the default 8)
   expectMovingCameraMatches(ctx(), compiler(), o, "temporal_moving");
 }
 

@@ -36,7 +36,7 @@ struct RestirOptions {
   int radius = 16;           // px
   int rounds = 1;            // R (0: no spatial reuse)
   int historyCap = 20;       // c (0: no temporal reuse)
-  int historyCapMoving = 1000;  // c while the camera moves (at most historyCap)
+  int historyCapMoving = 8;  // c while the camera moves (at most historyCap)
   uint32_t mis = shared::RS_MIS_PAIRWISE;
   int prefix = 16;           // K: vertices a reservoir's path holds (<= RS_MAX_VERTICES); the paths
                              // of more vertices are path traced in final shading (notes/restir.md)

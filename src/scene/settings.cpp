@@ -41,9 +41,11 @@ const std::vector<SettingDesc>& renderSettingsTable() {
        &RenderSettings::restirHistoryCap, 0, 1000, {}},
       {"restir_history_cap_moving",
        "ReSTIR: the temporal confidence cap while the camera moves (the smaller of it and restir_history_cap "
-       "applies, so the default 1000 adds none; 0 = no temporal reuse while it moves). A moving camera's history "
-       "is shifted into the new pixels; where many shifts fail (surfaces, small lamps) a shorter one is better "
-       "(the bundled city sets 5), over smoke alone the full one was (notes/city.md \"Session 17\")",
+       "applies; 0 = no temporal reuse while it moves). A moving camera's history is shifted into the new "
+       "pixels, and pairwise MIS lets a history sample whose target grows by a factor r under the shift weigh "
+       "up to about min(r, cap) times its usual weight: a long history turns the samples the shift brightens "
+       "most into lasting fireflies. 8 measured best over smoke (notes/restir.md \"Session 29\"); where many "
+       "shifts fail (surfaces, small lamps) a shorter one is (the bundled city sets 5)",
        &RenderSettings::restirHistoryCapMoving, 0, 1000, {}},
       {"restir_mis", "ReSTIR: MIS weights for reuse: pairwise (O(k)) or gbh (generalised balance heuristic, O(k^2))",
        &RenderSettings::restirMis, 0, 0, {"pairwise", "gbh"}},

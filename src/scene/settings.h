@@ -33,7 +33,7 @@ struct RenderSettings {
   int restirRadius = 16;             // spatial neighbour radius, pixels
   int restirRounds = 1;              // R: spatial rounds (0 = no spatial reuse)
   int restirHistoryCap = 20;         // temporal confidence cap c: M_hist <= c * M_cur (0 = no temporal)
-  int restirHistoryCapMoving = 1000; // ... while the camera moves (at most restirHistoryCap)
+  int restirHistoryCapMoving = 8;    // ... while the camera moves (at most restirHistoryCap)
   std::string restirMis = "pairwise";  // pairwise | gbh (generalised balance heuristic)
   int restirPrefix = 16;             // path vertices a reservoir holds; longer paths: a path-traced tail
   int restirLightCandidates = 2;     // light samples resampled at each candidate vertex (RIS)
