@@ -71,18 +71,31 @@ vec2 rs_direct_uv(uint i, vec2 u) {
   return min((cell + u) * (1.0f / float(RS_DIRECT_SIDE)), vec2(1.0f));
 }
 
-float rs_lamp_target(RsDomain D, uint v, uint uv) {
+// Le's luminance at the first surface along the ray of sub-pixel position uv (0 where that is no
+// emitter's front) and the hit's distance.
+float rs_lamp_emitted(RsDomain D, uint uv, out float t) {
   vec3 dir = rs_domain_dir(D, rs_unpack_uv(uv));
   BvhHit hit = bvh_closest(D.origin, dir, 0.0f, SURF_FAR);
-  if (hit.prim == BVH_NONE) return 0.0f;
-  float ph = rs_luminance(surf_emitted(hit.prim, surf_normal(hit.prim), dir));
-  return ph > 0.0f ? ph * vol_mean_tr(v, D.origin, dir, hit.t) : 0.0f;
+  t = hit.t;
+  return hit.prim == BVH_NONE ? 0.0f : rs_luminance(surf_emitted(hit.prim, surf_normal(hit.prim), dir));
+}
+
+float rs_lamp_target(RsDomain D, uint v, uint uv) {
+  float t;
+  float ph = rs_lamp_emitted(D, uv, t);
+  return ph > 0.0f ? ph * vol_mean_tr(v, D.origin, rs_domain_dir(D, rs_unpack_uv(uv)), t) : 0.0f;
 }
 
 // The frame's lamp reservoir of the pixel (set rsp.lampSet): RS_DIRECT_RAYS candidates, ray i
 // uniform on cell i of a RS_DIRECT_SIDE² grid of the pixel (density RS_DIRECT_RAYS there; MIS
-// weights "1 if (u, v) lies in cell i", a partition of the pixel), so candidate i's weight is
-// p̂(u_i, v_i) / RS_DIRECT_RAYS, confidence 1 in all. With a still camera the previous frame's
+// weights "1 if (u, v) lies in cell i", a partition of the pixel), confidence 1 in all. The
+// candidates are resampled by Le alone, p̂' (u, v) (candidate i's weight p̂'(u_i, v_i) /
+// RS_DIRECT_RAYS), so that W = w_sum / p̂'(Y) is an unbiased contribution weight of the selected
+// Y (GRIS: any target of the candidates' own resampling gives one); the reservoir's p̂ is the
+// target with the smoke's transmittance, evaluated once for Y, and the merge below and final
+// shading use that W with it. One mean-field walk a pixel instead of one per ray that meets a
+// lamp, masked per ray on a SIMD back end; the rays of one pixel see a lamp through nearly the
+// same smoke, so Le alone selects about as well (notes/city.md "Session 29"). With a still camera the previous frame's
 // reservoir at the same pixel (its confidence capped at c) is merged in with the generalised
 // balance heuristic between the two domains, m_s(y) = M_s p̂_s(y) / Σ_j M_j p̂_j(y), p̂_s the
 // target with the volume input s was rendered with (the shift is the identity: the same (u, v)
@@ -93,11 +106,13 @@ void rs_lamp_reservoir(RsDomain D, uint pixelIndex, inout RngState rng) {
   uint uv = 0u;
   for (uint i = 0u; i < RS_DIRECT_RAYS; ++i) {
     uint c = rs_pack_uv(rs_direct_uv(i, rng_float2(rng)));
-    float ph = rs_lamp_target(D, VOL_CURRENT, c);
+    float t;
+    float ph = rs_lamp_emitted(D, c, t);
     if (rs_update(r, ph * (1.0f / float(RS_DIRECT_RAYS)), ph, 0.0f, rng_float(rng))) uv = c;
   }
   r.M = 1.0f;
   rs_finalize(r);
+  r.p_hat = r.W > 0.0f ? rs_lamp_target(D, VOL_CURRENT, uv) : 0.0f;
   if (rsp.lampHistory != 0u) {
     vec4 stored = rs_state(rs_lamp_slot(1u - rsp.lampSet, pixelIndex));
     RsReservoir h = rs_empty();
