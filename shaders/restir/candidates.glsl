@@ -95,12 +95,13 @@ float rs_lamp_target(RsDomain D, uint v, uint uv) {
 // target with the smoke's transmittance, evaluated once for Y, and the merge below and final
 // shading use that W with it. One mean-field walk a pixel instead of one per ray that meets a
 // lamp, masked per ray on a SIMD back end; the rays of one pixel see a lamp through nearly the
-// same smoke, so Le alone selects about as well (notes/city.md "Session 29"). With a still camera the previous frame's
-// reservoir at the same pixel (its confidence capped at c) is merged in with the generalised
-// balance heuristic between the two domains, m_s(y) = M_s p̂_s(y) / Σ_j M_j p̂_j(y), p̂_s the
-// target with the volume input s was rendered with (the shift is the identity: the same (u, v)
-// in the same camera); with a still grid both targets are one function and m_s = M_s / ΣM. The
-// canonical input covers every (u, v) a lamp is seen through, so the merge is unbiased.
+// same smoke, so Le alone selects about as well (notes/city.md "Session 29"). With a still
+// camera the previous frame's reservoir at the same pixel (its confidence capped at c) is merged
+// in with the generalised balance heuristic between the two domains, m_s(y) = M_s p̂_s(y) /
+// Σ_j M_j p̂_j(y), p̂_s the target with the volume input s was rendered with (the shift is the
+// identity: the same (u, v) in the same camera); with a still grid both targets are one function
+// and m_s = M_s / ΣM. The canonical input covers every (u, v) a lamp is seen through, so the
+// merge is unbiased.
 void rs_lamp_reservoir(RsDomain D, uint pixelIndex, inout RngState rng) {
   RsReservoir r = rs_empty();
   uint uv = 0u;
