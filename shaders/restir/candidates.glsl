@@ -72,18 +72,19 @@ vec2 rs_direct_uv(uint i, vec2 u) {
 }
 
 // Le's luminance at the first surface along the ray of sub-pixel position uv (0 where that is no
-// emitter's front) and the hit's distance.
-float rs_lamp_emitted(RsDomain D, uint uv, out float t) {
-  vec3 dir = rs_domain_dir(D, rs_unpack_uv(uv));
+// emitter's front), the ray's direction and the hit's distance.
+float rs_lamp_emitted(RsDomain D, uint uv, out vec3 dir, out float t) {
+  dir = rs_domain_dir(D, rs_unpack_uv(uv));
   BvhHit hit = bvh_closest(D.origin, dir, 0.0f, SURF_FAR);
   t = hit.t;
   return hit.prim == BVH_NONE ? 0.0f : rs_luminance(surf_emitted(hit.prim, surf_normal(hit.prim), dir));
 }
 
 float rs_lamp_target(RsDomain D, uint v, uint uv) {
+  vec3 dir;
   float t;
-  float ph = rs_lamp_emitted(D, uv, t);
-  return ph > 0.0f ? ph * vol_mean_tr(v, D.origin, rs_domain_dir(D, rs_unpack_uv(uv)), t) : 0.0f;
+  float ph = rs_lamp_emitted(D, uv, dir, t);
+  return ph > 0.0f ? ph * vol_mean_tr(v, D.origin, dir, t) : 0.0f;
 }
 
 // The frame's lamp reservoir of the pixel (set rsp.lampSet): RS_DIRECT_RAYS candidates, ray i
@@ -107,8 +108,9 @@ void rs_lamp_reservoir(RsDomain D, uint pixelIndex, inout RngState rng) {
   uint uv = 0u;
   for (uint i = 0u; i < RS_DIRECT_RAYS; ++i) {
     uint c = rs_pack_uv(rs_direct_uv(i, rng_float2(rng)));
+    vec3 dir;
     float t;
-    float ph = rs_lamp_emitted(D, c, t);
+    float ph = rs_lamp_emitted(D, c, dir, t);
     if (rs_update(r, ph * (1.0f / float(RS_DIRECT_RAYS)), ph, 0.0f, rng_float(rng))) uv = c;
   }
   r.M = 1.0f;
