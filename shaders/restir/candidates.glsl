@@ -106,16 +106,23 @@ float rs_lamp_target(RsDomain D, uint v, uint uv) {
 void rs_lamp_reservoir(RsDomain D, uint pixelIndex, inout RngState rng) {
   RsReservoir r = rs_empty();
   uint uv = 0u;
+  vec3 dirY = vec3(0.0f);  // the selected ray's direction and hit distance
+  float tY = 0.0f;
   for (uint i = 0u; i < RS_DIRECT_RAYS; ++i) {
     uint c = rs_pack_uv(rs_direct_uv(i, rng_float2(rng)));
     vec3 dir;
     float t;
     float ph = rs_lamp_emitted(D, c, dir, t);
-    if (rs_update(r, ph * (1.0f / float(RS_DIRECT_RAYS)), ph, 0.0f, rng_float(rng))) uv = c;
+    if (rs_update(r, ph * (1.0f / float(RS_DIRECT_RAYS)), ph, 0.0f, rng_float(rng))) {
+      uv = c;
+      dirY = dir;
+      tY = t;
+    }
   }
   r.M = 1.0f;
   rs_finalize(r);
-  r.p_hat = r.W > 0.0f ? rs_lamp_target(D, VOL_CURRENT, uv) : 0.0f;
+  // p̂(Y) = Le(Y) T(Y), rs_lamp_target's value, without tracing Y's ray again.
+  r.p_hat = r.W > 0.0f ? r.p_hat * vol_mean_tr(VOL_CURRENT, D.origin, dirY, tY) : 0.0f;
   if (rsp.lampHistory != 0u) {
     vec4 stored = rs_state(rs_lamp_slot(1u - rsp.lampSet, pixelIndex));
     RsReservoir h = rs_empty();
