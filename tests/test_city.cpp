@@ -7,8 +7,11 @@
 #include "core/log.h"
 #include "geometry/obj.h"
 #include "geometry/scene_mesh.h"
+#include "media/bake.h"
 #include "media/vdb_loader.h"
 #include "render/gpu_surfaces.h"
+#include "render/gpu_volume.h"
+#include "render/restir.h"
 #include "shaders/shared/rng.h"
 #include "support/gpu_fixture.h"
 #include "support/light_tree.h"
@@ -19,6 +22,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -270,6 +274,56 @@ TEST_F(CityGpuTest, RestirMatchesReferenceOnTheBundledCity) {
   ASSERT_GT(RestirOptions{}.lightCandidates, 1) << "the test is meant for light resampling";
   const LoadedGrid grid = cityGrid(s);
   test::expectRestirMatchesReference(ctx(), compiler(), s, grid.grid, 1024, 16384, "city", {shared::RS_MIS_PAIRWISE});
+}
+
+// ReSTIR's lamps seen directly are traced only in the pixels whose camera rays may meet an
+// emitter's front (render/pixel_order.h emitterPixelMask, a pass of their own over them); every
+// other pixel's lamp reservoir would be empty, so the frames equal those of every pixel tracing
+// its 16 rays, bit for bit: the whole city at 40 x 40 (8000 emitters, some under a pixel wide),
+// four frames with a still camera (the lamp reservoirs' history merged) and four moving. Can it
+// fail: with the mask's triangles shrunk to their centroids (a sabotage of emitterPixelMask) the
+// frames differ.
+TEST_F(CityGpuTest, LampPassGivesTheFramesOfEveryPixelTracingItsLamps) {
+  Scene s = loadScene(test::sourcePath("volumes/city/city.json"));
+  s.camera.width = s.camera.height = 40;
+  s.render.maxBounces = 2;
+  const LoadedGrid grid = cityGrid(s);
+  const GpuVolumeResources volume(ctx(), bakeVolume(grid), s.medium().densityScale);
+  Scene moving = s;
+  CameraKey key;
+  key.frame = 4;
+  key.pose = s.camera.base;
+  key.pose.position += glm::vec3(0.3f, 0.1f, 0.0f);
+  moving.camera.keys.push_back(key);
+  for (const Scene* scene : {&s, &moving}) {
+    const char* name = scene == &s ? "still camera" : "moving camera";
+    auto frames = [&](bool cull, uint32_t& lampPixels) {
+      RestirOptions o;
+      o.cullLampPixels = cull;
+      Restir restir(ctx(), compiler(), *scene, o);
+      restir.setVolumes(volume, volume);
+      std::vector<Image> out;
+      for (int f = 1; f <= 4; ++f) out.push_back(restir.renderFrame(f, 1));
+      lampPixels = restir.lampPixels();
+      return out;
+    };
+    uint32_t culledPixels = 0, allPixels = 0;
+    const std::vector<Image> culled = frames(true, culledPixels), traced = frames(false, allPixels);
+    size_t differ = 0, lit = 0;
+    for (size_t f = 0; f < culled.size(); ++f) {
+      for (size_t i = 0; i < culled[f].rgb.size(); ++i) {
+        differ += std::memcmp(&culled[f].rgb[i], &traced[f].rgb[i], sizeof(float)) != 0 ? 1 : 0;
+        lit += traced[f].rgb[i] > 0.0f ? 1 : 0;
+      }
+    }
+    std::printf("[city] lamp pass, %s: %u of %u pixels traced; %zu of %zu channels differ\n", name, culledPixels,
+                allPixels, differ, lit);
+    EXPECT_EQ(allPixels, 40u * 40u) << name;
+    EXPECT_GT(culledPixels, 0u) << name;
+    EXPECT_LT(culledPixels, allPixels / 2) << name << ": the mask must leave most pixels out";
+    EXPECT_EQ(differ, 0u) << name << ": the lamp pass must not change any pixel";
+    EXPECT_GT(lit, culled.size() * culled[0].rgb.size() / 4) << name << ": too few lit channels";
+  }
 }
 
 // The bundled city on the device: 11922 triangles (the ground's 2, 392 boxes of 5 quads, 4000

@@ -210,4 +210,111 @@ TEST(PixelOrder, BoxesBehindAroundOrEmpty) {
   EXPECT_EQ(std::set<uint32_t>(every.pixels.begin(), every.pixels.end()).size(), 240u);
 }
 
+// The ray through image point (px, py) meets the front of triangle (a, b, c) (the side its
+// counter-clockwise normal points to: surf_emitted), at t > 0 (Möller-Trumbore, double).
+bool rayMeetsFront(const shared::GpuCamera& cam, int width, int height, double px, double py, glm::dvec3 a,
+                   glm::dvec3 b, glm::dvec3 c) {
+  const double sx = (2.0 * px / width - 1.0) * cam.tanHalfFovY * cam.aspect;
+  const double sy = (1.0 - 2.0 * py / height) * cam.tanHalfFovY;
+  const glm::dvec3 d = glm::dvec3(cam.forward) + sx * glm::dvec3(cam.right) + sy * glm::dvec3(cam.up);
+  const glm::dvec3 o(cam.position), e1 = b - a, e2 = c - a;
+  if (!(glm::dot(glm::cross(e1, e2), d) < 0.0)) return false;  // the back, or edge-on
+  const glm::dvec3 p = glm::cross(d, e2);
+  const double det = glm::dot(e1, p);
+  if (det == 0.0) return false;
+  const glm::dvec3 s = o - a;
+  const double u = glm::dot(s, p) / det;
+  const glm::dvec3 q = glm::cross(s, e1);
+  const double v = glm::dot(d, q) / det, t = glm::dot(e2, q) / det;
+  return u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > 0.0;
+}
+
+bool marked(const std::vector<uint32_t>& mask, int width, int x, int y) {
+  const size_t i = size_t(y) * size_t(width) + size_t(x);
+  return ((mask[i / 32] >> (i % 32)) & 1u) != 0u;
+}
+
+size_t markedCount(const std::vector<uint32_t>& mask, int width, int height) {
+  size_t n = 0;
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) n += marked(mask, width, x, y) ? 1 : 0;
+  return n;
+}
+
+// render/pixel_order.h emitterPixelMask: every pixel one of whose camera rays meets an emitter's
+// front is marked (ReSTIR traces the lamps seen directly in those pixels only, so a pixel left out
+// wrongly would lose its lamp). Random cameras and triangles of every size (from a few hundredths
+// of a pixel to larger than the image), facing any way, some across or behind the camera's plane;
+// 24 rays per pixel (its corners, centre and random points) in double precision.
+TEST(PixelOrder, EveryPixelThatSeesAnEmittersFrontIsMarked) {
+  std::mt19937 rng(777);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  size_t missed = 0, hits = 0, marks = 0, pixels = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const int width = 16 + int(rng() % 40), height = 12 + int(rng() % 40);
+    const glm::vec3 position(4.0f * u(rng), 4.0f * u(rng), 4.0f * u(rng));
+    const glm::vec3 lookAt = position + glm::normalize(glm::vec3(u(rng), u(rng), u(rng)) + glm::vec3(0.0f, 0.0f, 1e-3f));
+    const shared::GpuCamera cam = cameraAt(position, lookAt, 25.0f + 20.0f * (u(rng) + 1.0f), width, height);
+    std::vector<glm::vec3> vertices;
+    for (int k = 0; k < 12; ++k) {
+      // Centres in front (most), around or behind the camera; sizes from 1e-3 to 3 units.
+      const float ahead = k < 9 ? 1.0f + 5.0f * (u(rng) + 1.0f) : 2.0f * u(rng);
+      const glm::vec3 centre = position + ahead * cam.forward + 2.0f * glm::vec3(u(rng), u(rng), u(rng));
+      const float size = std::pow(10.0f, -3.0f + 1.75f * (u(rng) + 1.0f));
+      for (int c = 0; c < 3; ++c) vertices.push_back(centre + size * glm::vec3(u(rng), u(rng), u(rng)));
+    }
+    const std::vector<uint32_t> mask = emitterPixelMask(cam, width, height, vertices);
+    ASSERT_EQ(mask.size(), (size_t(width) * height + 31) / 32);
+    std::uniform_real_distribution<double> w(0.0, 1.0);
+    for (int y = 0; y < height; ++y) {
+      for (int x = 0; x < width; ++x) {
+        bool any = false;
+        for (int r = 0; r < 24 && !any; ++r) {
+          const double fx = r < 4 ? (r & 1) : r == 4 ? 0.5 : w(rng), fy = r < 4 ? (r >> 1) : r == 4 ? 0.5 : w(rng);
+          for (size_t k = 0; k < vertices.size() && !any; k += 3) {
+            any = rayMeetsFront(cam, width, height, x + fx, y + fy, glm::dvec3(vertices[k]), glm::dvec3(vertices[k + 1]),
+                                glm::dvec3(vertices[k + 2]));
+          }
+        }
+        hits += any ? 1 : 0;
+        missed += any && !marked(mask, width, x, y) ? 1 : 0;
+      }
+    }
+    marks += markedCount(mask, width, height);
+    pixels += size_t(width) * height;
+  }
+  std::printf("[pixel order] emitters: %zu of %zu pixels see a front, %zu marked, %zu missed\n", hits, pixels, marks,
+              missed);
+  EXPECT_EQ(missed, 0u) << "a pixel that sees an emitter's front must be marked";
+  EXPECT_GT(hits, pixels / 20) << "too few pixels see an emitter for the test to mean much";
+  EXPECT_LT(marks, pixels * 3 / 4) << "the mask must leave pixels out";
+}
+
+// What the mask leaves out: a triangle whose back faces the camera, one behind the camera's plane;
+// and a small one in the image marks the pixel it covers and at most its neighbours within the
+// margin (a sixteenth of a pixel).
+TEST(PixelOrder, EmitterMaskLeavesOutBacksAndTheUnseen) {
+  const int width = 32, height = 24;
+  const shared::GpuCamera cam = cameraAt({0.0f, 0.0f, 5.0f}, {0.0f, 0.0f, 0.0f}, 40.0f, width, height);
+  auto count = [&](std::vector<glm::vec3> v) { return markedCount(emitterPixelMask(cam, width, height, v), width, height); };
+  // Facing the camera (counter-clockwise seen from +z: its normal points at the camera) and its back.
+  const std::vector<glm::vec3> front = {{-1.0f, -1.0f, 0.0f}, {1.0f, -1.0f, 0.0f}, {0.0f, 1.0f, 0.0f}};
+  const std::vector<glm::vec3> back = {front[0], front[2], front[1]};
+  EXPECT_GT(count(front), 20u);
+  EXPECT_EQ(count(back), 0u);
+  // Behind the camera (which looks towards -z), facing it.
+  EXPECT_EQ(count({{-1.0f, -1.0f, 8.0f}, {0.0f, 1.0f, 8.0f}, {1.0f, -1.0f, 8.0f}}), 0u);
+  // Across the camera's plane: marks the pixels towards its front part (not none, not all).
+  const size_t across = count({{-3.0f, 0.5f, 7.0f}, {-3.0f, -0.5f, 7.0f}, {-0.5f, 0.0f, 3.0f}});
+  EXPECT_GT(across, 0u);
+  EXPECT_LT(across, size_t(width * height));
+  // A hundredth of a pixel wide, at a pixel's centre: that pixel alone.
+  const double pixel = 2.0 * 5.0 * std::tan(glm::radians(20.0)) / height;  // world units per pixel at z = 0
+  const glm::vec3 c(float((0.5 - 0.5 * width + 10.0) * pixel), float((0.5 * height - 0.5 - 7.0) * pixel), 0.0f);
+  const float h = float(0.005 * pixel);
+  const std::vector<uint32_t> one = emitterPixelMask(cam, width, height, {c + glm::vec3(-h, -h, 0.0f), c + glm::vec3(h, -h, 0.0f), c + glm::vec3(0.0f, h, 0.0f)});
+  EXPECT_EQ(markedCount(one, width, height), 1u);
+  EXPECT_TRUE(marked(one, width, 10, 7));
+}
+
 }  // namespace

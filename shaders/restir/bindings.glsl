@@ -20,7 +20,8 @@
 #endif
 
 // The parameters, then the frame's pixels in the order its passes take them (render/pixel_order.h:
-// packed x | y << 16; first those whose camera rays may meet the volume, then the others).
+// packed x | y << 16; first those whose camera rays may meet the volume, then the others), then,
+// with emissive surfaces, a bit per pixel (rs_lamp_pixel).
 layout(std430, binding = BIND_RS_PARAMS) readonly buffer RestirParamBuffer {
   RestirParams rsParams;
   uint rsPixels[];
@@ -60,6 +61,10 @@ layout(std430, binding = BIND_RS_OUTPUT) buffer OutputBuffer { vec4 rsOutput[]; 
 layout(std430, binding = BIND_RS_COUNTERS) buffer RestirCounterBuffer { uint rsCounters[]; };
 
 layout(push_constant) uniform PushBlock { RsPush push; };
+
+// Whether the camera rays of pixel `index` (y * width + x) may meet an emitter's front: the bits
+// after the pixel list (render/pixel_order.h emitterPixelMask; with emissive surfaces only).
+bool rs_lamp_pixel(uint index) { return ((rsPixels[rsp.pixelCount + (index >> 5u)] >> (index & 31u)) & 1u) != 0u; }
 
 // The pixel of this invocation of a dispatch over rsPixels[push.listBegin ..][.. push.listCount]
 // (one-dimensional workgroups); false past the list's end.

@@ -214,17 +214,20 @@ vec3 rs_light_term(uint v, PathVertex vx, uint light, vec2 ls, uint prim, bool u
 // weight, which costs a second descent of the light tree), which is positive wherever the
 // shadowed term is, so the chosen sample's contribution weight
 //   W = (1 / p̂_u(chosen)) * (1 / L) * sum_k p̂_u(l_k) / p_light(l_k)
-// is unbiased for 1 / (its density) (RIS; GRIS accepts it as a candidate's weight). One shadow
-// ray is then paid for the survivor alone (rs_light_term). Among thousands of small emitters
-// the unshadowed term's cosines and 1/d² find the lamps that face the vertex; the host compiles
-// L > 1 with emissive surfaces only (render/restir.cpp says why). Returns W (0: no sample with a
-// nonzero term).
-float rs_resample_light(PathVertex vx, vec3 f, inout RngState rng, out uint light, out vec2 ls, out uint prim) {
+// is unbiased for 1 / (its density) (RIS; GRIS accepts it as a candidate's weight). Among
+// thousands of small emitters the unshadowed term's cosines and 1/d² find the lamps that face the
+// vertex; the host compiles L > 1 with emissive surfaces only (render/restir.cpp says why).
+// Returns W (0: no sample with a nonzero term) and the survivor's connection `chosenRay` (its
+// value without the emitters' MIS weight), which the candidates' own resampling reads
+// (candidates.glsl: no shadow ray per vertex).
+float rs_resample_light(PathVertex vx, vec3 f, inout RngState rng, out uint light, out vec2 ls, out uint prim,
+                        out RsLightRay chosenRay) {
   float wSum = 0.0f;
   float chosen = 0.0f;
   light = 0u;
   ls = vec2(0.0f);
   prim = 0u;
+  chosenRay = RsLightRay(vx.x, vec3(0.0f, 0.0f, 1.0f), 0.0f, vec3(0.0f));
   for (uint k = 0u; k < uint(PLUME_RS_LIGHT_CANDIDATES); ++k) {
     uvec4 h = rng_next4(rng);
     uint lk;
@@ -241,6 +244,7 @@ float rs_resample_light(PathVertex vx, vec3 f, inout RngState rng, out uint ligh
       ls = lsk;
       prim = pk;
       chosen = ph;
+      chosenRay = c;
     }
   }
   return chosen > 0.0f ? wSum / (float(PLUME_RS_LIGHT_CANDIDATES) * chosen) : 0.0f;
@@ -347,7 +351,8 @@ float rs_reconnect_area_factor(uint prim, vec3 w, float d) { return abs(dot(surf
 // With the reconnection shift vertex r = rs_reconnect_vertex is the stored point x_r instead:
 // o_{r-1} is connected to it (f = 0 where a surface lies between) and f carries its area factor.
 //
-// shading false: the target's f (every transmittance the mean field's, est = 1). shading true
+// shading false: the target's f (every transmittance the mean field's), and est the product of
+// the path's segment transmittances in it (not the light ray's: rs_target_parts). shading true
 // (final shading, D the current frame's domain): f without the path's segment transmittances,
 // and est an unbiased estimate of the ratio of the fine transmittances to the target's, so that
 // f * (product of the segments' exp(-tau_c)) * est is unbiased for the path's contribution. The
@@ -431,6 +436,7 @@ vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool shading, i
       est *= vol_residual_ratio(x, w, t, rng);
     } else {
       tr = vol_mean_tr(D.v, x, w, t);
+      est *= tr;
     }
 #ifdef PLUME_RS_RECONNECT
     if (rc) tr *= rs_reconnect_area_factor(hit.prim, w, t);
@@ -470,11 +476,17 @@ vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool shading, i
   return f * c.value * trTarget;
 }
 
-// The target function p̂_D(y): deterministic (no random numbers are drawn on this path).
-float rs_target(RsDomain D, uint set, uint pixelIndex) {
+// The target function p̂_D(y): deterministic (no random numbers are drawn on this path); and the
+// product of the path's segment transmittances in it, segments (the factor of p̂ that the
+// candidates' weights leave out: candidates.glsl).
+float rs_target_parts(RsDomain D, uint set, uint pixelIndex, out float segments) {
   RngState unused = RngState(uvec4(0u), 0u);  // never drawn from: no hash to pay for
-  float est;
-  return rs_luminance(rs_path_contribution(D, set, pixelIndex, false, unused, est));
+  return rs_luminance(rs_path_contribution(D, set, pixelIndex, false, unused, segments));
+}
+
+float rs_target(RsDomain D, uint set, uint pixelIndex) {
+  float segments;
+  return rs_target_parts(D, set, pixelIndex, segments);
 }
 
 #endif

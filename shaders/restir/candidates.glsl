@@ -103,6 +103,15 @@ float rs_lamp_target(RsDomain D, uint v, uint uv) {
 // identity: the same (u, v) in the same camera); with a still grid both targets are one function
 // and m_s = M_s / ΣM. The canonical input covers every (u, v) a lamp is seen through, so the
 // merge is unbiased.
+// It runs in a pass of its own (passes/restir_lamps.comp) over the pixels whose camera rays may
+// meet an emitter's front (rs_lamp_pixel: conservative), dense; the others' reservoirs are empty
+// (every candidate's weight would be 0) and the candidates pass writes them (rs_lamp_skipped).
+// Both draw from the start of the pixel's candidates stream, RS_LAMP_DRAWS numbers, and the
+// walks go on from there.
+const uint RS_LAMP_DRAWS = 2u * RS_DIRECT_RAYS;  // (u, v) and the selection, per ray; 2 more to merge
+
+uint rs_lamp_draws() { return RS_LAMP_DRAWS + (rsp.lampHistory != 0u ? 2u : 0u); }
+
 void rs_lamp_reservoir(RsDomain D, uint pixelIndex, inout RngState rng) {
   RsReservoir r = rs_empty();
   uint uv = 0u;
@@ -144,10 +153,14 @@ void rs_lamp_reservoir(RsDomain D, uint pixelIndex, inout RngState rng) {
   }
   rs_set_state(rs_lamp_slot(rsp.lampSet, pixelIndex), vec4(r.W, r.M, uintBitsToFloat(uv), r.p_hat));
 }
+
+// The lamp reservoir of a pixel outside the lamp pass's list: empty (its confidence is read by no
+// one: the pixel stays outside the list while the camera is still, the only time a history is merged).
+void rs_lamp_skipped(uint pixelIndex) { rs_set_state(rs_lamp_slot(rsp.lampSet, pixelIndex), vec4(0.0f, 1.0f, 0.0f, 0.0f)); }
 #endif
 
 // Walks first .. first + rsp.walksPerDispatch - 1 (at most M - 1) of the pixel's M; the first
-// dispatch also makes the pixel's lamp reservoir (rs_lamp_reservoir).
+// dispatch also writes the pixel's lamp reservoir where the lamp pass does not (rs_lamp_skipped).
 void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
   RsDomain D = rs_current_domain(pixel);
   RngState rng = rng_init(pixel, frame.frameKey, RNG_STREAM_CANDIDATES, frame.seed);
@@ -182,12 +195,18 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
     head.lightPrim = 0u;
   } else {  // the walks before this one
     vec4 state = rs_state(rs_state_slot(pixelIndex));
-    r.w_sum = state.x;  // (p̂ is evaluated on the selected path at the end)
+    r.w_sum = state.x;
+    r.p_hat = state.y;  // the candidates' own target of the selected one
     rng.counter = floatBitsToUint(state.z);
     head = rs_load_head(outSet, pixelIndex);
   }
 #ifdef PLUME_HAS_EMITTERS
-  if (first == 0u) rs_lamp_reservoir(D, pixelIndex, rng);
+  // The lamp reservoir: the lamp pass's (passes/restir_lamps.comp), or empty; either way the
+  // walks' numbers follow its draws.
+  if (first == 0u) {
+    if (!rs_lamp_pixel(pixelIndex)) rs_lamp_skipped(pixelIndex);
+    rng.counter = rs_lamp_draws();
+  }
 #endif
   vec4 walk[RS_MAX_VERTICES - 1u];
 #ifdef PLUME_RS_OUTSIDE
@@ -317,8 +336,9 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
       vec2 ls;
       uint prim;
 #if PLUME_RS_LIGHT_CANDIDATES > 1
-      // L light samples resampled by their unshadowed term, one shadow ray (bridge.glsl)
-      float wLight = rs_resample_light(vx, f, rng, light, ls, prim);
+      // L light samples resampled by their unshadowed term (bridge.glsl)
+      RsLightRay lightRay;
+      float wLight = rs_resample_light(vx, f, rng, light, ls, prim, lightRay);
       float uSelect = rng_float(rng);
 #else
       uvec4 h = rng_next4(rng);
@@ -327,7 +347,14 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
       float uSelect = rng_to_float(h.w);
 #endif
       if (wLight > 0.0f) {
+#if PLUME_RS_LIGHT_CANDIDATES > 1
+        // The candidates' own target for a light sample among emissive triangles: the light
+        // term without the light ray's visibility and the emitter's MIS weight (the walk's
+        // target otherwise, header): no shadow ray and no second light-tree pmf per vertex.
+        float ph = rs_luminance(f * lightRay.value) * rs_target_light_tr(VOL_CURRENT, lightRay);
+#else
         float ph = rs_luminance(f * rs_light_term(VOL_CURRENT, vx, light, ls, prim, false, rng));
+#endif
         float weight = invM * ph * wLight / pdf;
         if (rs_update(r, weight, ph, 0.0f, uSelect)) {
           head = rs_candidate_head(uv, t1, j, kinds, light, ls, prim);
@@ -367,17 +394,33 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
     }
   }
   if (last < M) {
-    rs_set_state(rs_state_slot(pixelIndex), vec4(r.w_sum, 0.0f, uintBitsToFloat(rng.counter), 0.0f));
+    rs_set_state(rs_state_slot(pixelIndex), vec4(r.w_sum, r.p_hat, uintBitsToFloat(rng.counter), 0.0f));
     rs_store_head(outSet, pixelIndex, head);
     return;
   }
   r.M = float(M);
   rs_store_head(outSet, pixelIndex, head);
+#if PLUME_RS_LIGHT_CANDIDATES > 1
+  // The candidates' own target p̂' of light samples left out the light ray's visibility and the
+  // emitter's MIS weight (above), so W = w_sum / p̂'(Y), p̂'(Y) the value rs_update kept for Y times
+  // the segments' transmittances that every weight left out (GRIS: any target of the candidates'
+  // own resampling that is positive wherever p̂ is gives an unbiased contribution weight). The
+  // reservoir's p̂ is the target: 0 where Y's light ray is blocked, and then the reservoir holds
+  // no path (f(Y) = 0, so W f(Y) is 0 either way, and reuse weighs an input by its target in its
+  // own domain).
+  float segments = 0.0f;
+  float target = head.vertexCount > 0u && r.w_sum > 0.0f ? rs_target_parts(D, outSet, pixelIndex, segments) : 0.0f;
+  r.p_hat *= segments;
+  rs_finalize(r);
+  r.p_hat = target;
+  if (!(target > 0.0f)) r.W = 0.0f;
+#else
 #ifndef PLUME_RS_OUTSIDE
   // The target of the selected path, with its transmittances (the weights' p̂ left them out).
   r.p_hat = head.vertexCount > 0u && r.w_sum > 0.0f ? rs_target(D, outSet, pixelIndex) : 0.0f;
 #endif
   rs_finalize(r);
+#endif
   if (r.W <= 0.0f) rs_clear_path(outSet, pixelIndex);
   rs_store(outSet, pixelIndex, r);
 }

@@ -136,6 +136,7 @@ GpuSurfaces::GpuSurfaces(gpu::Context& ctx, const Scene& scene) {
     if (p > 0.0) {
       emitterSummary_.push_back({(t.v0 + t.v1 + t.v2) / 3.0f, glm::normalize(glm::cross(t.v1 - t.v0, t.v2 - t.v0)), p});
       emitters.push_back({t.v0, t.v1, t.v2, p, uint32_t(i)});
+      emitterVertices_.insert(emitterVertices_.end(), {t.v0, t.v1, t.v2});
       t.emitterInvArea = float(1.0 / a);
     }
   }

@@ -47,6 +47,8 @@ class GpuSurfaces {
   // sum of mean(Le) A max(cos, 0) / (4 pi r^2) over the emissive triangles (ReSTIR's light choice).
   double emitterPowerAt(glm::vec3 p) const;
   uint32_t emitterCount() const { return emitterCount_; }
+  // The emissive triangles' corners, three per triangle, as the device holds them (world space).
+  const std::vector<glm::vec3>& emitterVertices() const { return emitterVertices_; }
   const geo::BvhStats& bvhStats() const { return stats_; }
   double uploadMs() const { return uploadMs_; }
 
@@ -59,6 +61,7 @@ class GpuSurfaces {
     double power;  // area times mean(Le)
   };
   std::vector<EmitterSummary> emitterSummary_;
+  std::vector<glm::vec3> emitterVertices_;
   geo::BvhStats stats_;
   double uploadMs_ = 0.0;
 };

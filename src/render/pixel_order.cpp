@@ -154,4 +154,64 @@ PixelOrder volumePixelOrder(const shared::GpuCamera& cam, int width, int height,
   return order;
 }
 
+std::vector<uint32_t> emitterPixelMask(const shared::GpuCamera& cam, int width, int height,
+                                       const std::vector<glm::vec3>& vertices) {
+  PLUME_CHECK(width > 0 && height > 0 && width <= 65536 && height <= 65536 && vertices.size() % 3 == 0);
+  const size_t n = size_t(width) * size_t(height);
+  std::vector<uint32_t> mask((n + 31) / 32, 0u);
+  const glm::dvec3 pos(cam.position), fwd(cam.forward), right(cam.right), up(cam.up);
+  const double tanY = double(cam.tanHalfFovY), tanX = tanY * double(cam.aspect);
+  for (size_t k = 0; k < vertices.size(); k += 3) {
+    const glm::dvec3 v[3] = {glm::dvec3(vertices[k]), glm::dvec3(vertices[k + 1]), glm::dvec3(vertices[k + 2])};
+    // The camera behind the triangle's plane sees its back only (up to a tolerance far above the
+    // device's rounding of the normal's cross product, even for a sliver; a degenerate triangle is kept).
+    const glm::dvec3 e1 = v[1] - v[0], e2 = v[2] - v[0];
+    const double tolerance = 1e-5 * glm::length(e1) * glm::length(e2) * (glm::length(e1) + glm::length(e2) + glm::length(pos - v[0]));
+    if (glm::dot(glm::cross(e1, e2), pos - v[0]) < -tolerance) continue;
+    // Clipped to z >= eps in front of the camera (every ray leaves it forwards: cam_direction).
+    double z[3];
+    double eps = 0.0;
+    for (int i = 0; i < 3; ++i) {
+      z[i] = glm::dot(v[i] - pos, fwd);
+      eps = std::max(eps, 1e-9 * std::max(1.0, glm::length(v[i] - pos)));
+    }
+    std::array<glm::dvec3, 4> poly;
+    int count = 0;
+    for (int i = 0; i < 3; ++i) {
+      const int j = (i + 1) % 3;
+      if (z[i] >= eps) poly[size_t(count++)] = v[i];
+      if ((z[i] - eps) * (z[j] - eps) < 0.0) poly[size_t(count++)] = v[i] + (v[j] - v[i]) * ((eps - z[i]) / (z[j] - z[i]));
+    }
+    if (count == 0) continue;
+    double xmin = std::numeric_limits<double>::infinity(), xmax = -xmin, ymin = xmin, ymax = -xmin;
+    for (int i = 0; i < count; ++i) {
+      const glm::dvec3 d = poly[size_t(i)] - pos;
+      const double zc = std::max(glm::dot(d, fwd), eps);
+      const double px = (glm::dot(d, right) / zc / tanX + 1.0) * 0.5 * width;
+      const double py = (1.0 - glm::dot(d, up) / zc / tanY) * 0.5 * height;
+      xmin = std::min(xmin, px);
+      xmax = std::max(xmax, px);
+      ymin = std::min(ymin, py);
+      ymax = std::max(ymax, py);
+    }
+    if (!(std::isfinite(xmin) && std::isfinite(xmax) && std::isfinite(ymin) && std::isfinite(ymax))) {
+      std::fill(mask.begin(), mask.end(), ~0u);  // (not a number: every pixel)
+      break;
+    }
+    // The pixels [x0, x1) x [y0, y1) whose squares meet the rectangle grown by the margin.
+    const double m = kEmitterPixelMargin;
+    const int x0 = int(std::clamp(std::floor(xmin - m), 0.0, double(width)));
+    const int x1 = int(std::clamp(std::floor(xmax + m) + 1.0, 0.0, double(width)));
+    const int y0 = int(std::clamp(std::floor(ymin - m), 0.0, double(height)));
+    const int y1 = int(std::clamp(std::floor(ymax + m) + 1.0, 0.0, double(height)));
+    for (int y = y0; y < y1; ++y) {
+      for (int x = x0; x < x1; ++x) {
+        const size_t i = size_t(y) * size_t(width) + size_t(x);
+        mask[i / 32] |= 1u << (i % 32);
+      }
+    }
+  }
+  return mask;
+}
+
 }  // namespace plume

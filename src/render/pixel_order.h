@@ -53,6 +53,19 @@ PixelOrder volumePixelOrder(const shared::GpuCamera& cam, int width, int height,
 // Every pixel, in tile order, all inside.
 PixelOrder allPixels(int width, int height);
 
+// The pixels of a width x height image seen by the pinhole camera `cam` whose rays may meet the
+// front of an emissive triangle (`vertices`: three world-space corners per triangle; the front is
+// the side its corners' counter-clockwise normal points to, where surf_emitted emits): bit
+// (y * width + x) % 32 of word (y * width + x) / 32 (ReSTIR's lamp reservoir traces its camera
+// rays in those pixels only: restir/candidates.glsl). Conservative: a triangle is left out only
+// when the camera is behind its plane or it lies wholly behind the camera's plane; the rest mark
+// the bounding rectangle of their projection (clipped to the front of the camera's plane) grown
+// by kEmitterPixelMargin pixels (a device's rounding of a camera ray is below 10^-5 pixels at
+// 8192 pixels across; a lamp smaller than a pixel should mark one or two in each direction, not three).
+constexpr double kEmitterPixelMargin = 1.0 / 16.0;
+std::vector<uint32_t> emitterPixelMask(const shared::GpuCamera& cam, int width, int height,
+                                       const std::vector<glm::vec3>& vertices);
+
 inline uint32_t packPixel(uint32_t x, uint32_t y) { return x | y << 16; }
 
 }  // namespace plume

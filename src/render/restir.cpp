@@ -8,6 +8,7 @@
 #include <glm/glm.hpp>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 namespace plume {
@@ -200,6 +201,8 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
                                               uint32_t(sizeof(shared::RsPush)), name + variant, glm::uvec3(64, 1, 1));
   };
   candidates_ = make("passes/restir_candidates.comp", "restir candidates", {});
+  // The lamps seen directly, over the pixels whose camera rays may meet an emitter (restir/candidates.glsl).
+  if (features_.emitters) lamps_ = make("passes/restir_lamps.comp", "restir lamps", {});
   temporal_ = make("passes/restir_reuse.comp", "restir temporal", {{"PLUME_RS_TEMPORAL", "1"}});
   // Temporal reuse where the history's domain is the current one (params_.historySameDomain):
   // the identity shift and stored targets only, no target evaluation compiled in (restir/reuse.glsl).
@@ -236,8 +239,11 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   lightBuffer_ = lightTexels(ctx, lights);
   const size_t choices = std::max(lights.size(), scene.lights.size() + (features_.emitters ? 1 : 0));
   lightChoice_ = gpu::Buffer(ctx, choices * sizeof(shared::GpuLightChoice), storage, "light choice");
-  // The parameters, then the frame's pixels in the passes' order (restir/bindings.glsl rsPixels).
-  paramBuffer_ = gpu::Buffer(ctx, sizeof(shared::RestirParams) + pixels * sizeof(uint32_t), storage,
+  // The parameters, then the frame's pixels in the passes' order, then with emissive surfaces a
+  // bit per pixel, set where its camera rays may meet an emitter, and those pixels' list
+  // (restir/bindings.glsl rsPixels, rs_lamp_pixel).
+  const size_t lampWords = features_.emitters ? (pixels + 31) / 32 + pixels : 0;
+  paramBuffer_ = gpu::Buffer(ctx, sizeof(shared::RestirParams) + (pixels + lampWords) * sizeof(uint32_t), storage,
                              "restir parameters");
   static_assert(sizeof(shared::RsPacked) == 16 && sizeof(shared::RsPathHead) == 32);  // 1 and 2 texels
   reservoirs_ = gpu::TexelBuffer(ctx, nullptr, kSets * pixels, VK_FORMAT_R32G32B32A32_UINT, "reservoirs", true);
@@ -312,7 +318,8 @@ void Restir::setVolumes(const GpuVolumeResources& current, const GpuVolumeResour
 std::vector<gpu::ComputePass*> Restir::passes() const {
   std::vector<gpu::ComputePass*> p = {candidates_.get(), temporal_.get(), temporalSame_.get(), spatial_.get(),
                                       shade_.get()};
-  for (gpu::ComputePass* q : {candidatesOut_.get(), temporalOut_.get(), spatialOut_.get(), shadeOut_.get(), tail_.get()}) {
+  for (gpu::ComputePass* q : {candidatesOut_.get(), temporalOut_.get(), spatialOut_.get(), shadeOut_.get(), tail_.get(),
+                              lamps_.get()}) {
     if (q) p.push_back(q);
   }
   return p;
@@ -354,6 +361,19 @@ void Restir::fillFrame(int frame, uint32_t sequence, uint32_t key) {
     pixelOrder_ = candidatesOut_ ? volumePixelOrder(cam, w, h, footprint_) : allPixels(w, h);
     paramBuffer_.upload(pixelOrder_.pixels.data(), pixelOrder_.pixels.size() * sizeof(uint32_t),
                         sizeof(shared::RestirParams));
+    if (lamps_) {
+      // The mask, then its pixels in tile order (the lamp pass's list).
+      std::vector<uint32_t> lamps = options_.cullLampPixels ? emitterPixelMask(cam, w, h, surfaces_->emitterVertices())
+                                                            : std::vector<uint32_t>((size_t(w) * h + 31) / 32, ~0u);
+      const size_t maskWords = lamps.size();
+      for (uint32_t packed : allPixels(w, h).pixels) {
+        const size_t i = size_t(packed >> 16) * size_t(w) + (packed & 0xffffu);
+        if ((lamps[i / 32] >> (i % 32)) & 1u) lamps.push_back(packed);
+      }
+      lampPixels_ = uint32_t(lamps.size() - maskWords);
+      paramBuffer_.upload(lamps.data(), lamps.size() * sizeof(uint32_t),
+                          sizeof(shared::RestirParams) + pixelOrder_.pixels.size() * sizeof(uint32_t));
+    }
     orderCam_ = cam;
     orderSerial_ = currentSerial_;
   }
@@ -401,6 +421,10 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
     // walksPerDispatch candidate walks per dispatch (lavapipe's loop budget: restir/candidates.glsl);
     // the outside variant's M walks (none of them reaches a vertex) in one.
     const uint32_t candidates = timer_.begin(cmd, "restir candidates");
+    if (lamps_) {  // (its pixels' lamp reservoirs; the candidates pass writes the others')
+      const uint32_t listBegin = all + (all + 31) / 32;
+      over(*lamps_, push, listBegin, lampPixels_);
+    }
     for (uint32_t m = 0; m < params_.candidates; m += params_.walksPerDispatch) {
       if (m > 0) gpu::computeBarrier(cmd);
       push.candidate = m;

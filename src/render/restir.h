@@ -58,6 +58,10 @@ struct RestirOptions {
   // camera rays may meet the volume only (render/pixel_order.h) and walk-free variants of the
   // passes over the others (PLUME_RS_OUTSIDE); the two must give one image, bit for bit.
   bool cullOutside = true;
+  // Tests only: false traces the lamp reservoir's camera rays in every pixel, instead of those
+  // whose rays may meet an emitter's front (render/pixel_order.h emitterPixelMask; the others'
+  // reservoirs are empty either way); the two must give one image, bit for bit.
+  bool cullLampPixels = true;
   // Tests only: true keeps the stored paths' vertices in a storage buffer (PLUME_RS_VERTEX_BUFFER)
   // as on a device whose texel buffers cannot hold them but whose storage buffers can (otherwise
   // the device's limits choose: Restir::Restir); the two must give one image, bit for bit.
@@ -100,6 +104,9 @@ class Restir {
   // Reservoir unpacks whose non-finite weights were dropped since the last call (DESIGN §4.2.3):
   // the passes count on the device; one read-back when asked, not one per iteration.
   uint32_t takeDroppedCount();
+  // Pixels of the last frame whose lamp reservoir traced its camera rays (emitterPixelMask; every
+  // pixel without options().cullLampPixels; 0 without emissive surfaces).
+  uint32_t lampPixels() const { return lampPixels_; }
 
  private:
   void fillFrame(int frame, uint32_t sequence, uint32_t key);
@@ -118,6 +125,7 @@ class Restir {
   std::unique_ptr<GpuEnvironmentMap> envMap_;
   std::unique_ptr<GpuSurfaces> surfaces_;  // only for a scene with surfaces
   std::unique_ptr<gpu::ComputePass> candidates_, temporal_, temporalSame_, spatial_, shade_;
+  std::unique_ptr<gpu::ComputePass> lamps_;  // the lamps seen directly (only with emissive surfaces)
   // The passes' variants for the pixels whose camera rays miss the volume (PLUME_RS_OUTSIDE;
   // null with surfaces, or without options_.cullOutside).
   std::unique_ptr<gpu::ComputePass> candidatesOut_, temporalOut_, spatialOut_, shadeOut_;
@@ -144,6 +152,7 @@ class Restir {
   // The frame's pixels, those that may see the volume first (render/pixel_order.h), and the
   // camera and volume they were found for (recomputed and uploaded when either changes).
   PixelOrder pixelOrder_;
+  uint32_t lampPixels_ = 0;  // pixels of the lamp mask (after the order in paramBuffer_), for the log
   shared::GpuCamera orderCam_{};
   uint64_t orderSerial_ = 0;
   PassTimes passTimes_;
