@@ -116,17 +116,20 @@ PLUME_FN uint lt_sample(vec3 x, float u, OUT(float) pmf) {
 
 // The probability with which lt_sample picks the triangle whose trail is `trail` at x: bit k is
 // the turn at depth k (1: the second child), and a 1 above the last turn; 0: not in the tree.
+// Two nodes read per level, the children, as lt_sample reads them (the next pair's index is the
+// chosen child's `child`).
 PLUME_FN float lt_pmf(vec3 x, uint trail) {
   if (trail == 0u) return 0.0f;
   float pmf = 1.0f;
-  uint node = 0u;
+  uint child = LT_NODE(0u).child;
   while (trail > 1u) {
-    GpuLightNode nd = LT_NODE(node);
-    float p0 = lt_first_child_probability(lt_importance(LT_NODE(nd.child), x), lt_importance(LT_NODE(nd.child + 1u), x));
+    GpuLightNode a = LT_NODE(child);
+    GpuLightNode b = LT_NODE(child + 1u);
+    float p0 = lt_first_child_probability(lt_importance(a, x), lt_importance(b, x));
     if (p0 < 0.0f) return 0.0f;
     bool second = (trail & 1u) != 0u;
     pmf *= second ? 1.0f - p0 : p0;
-    node = nd.child + (second ? 1u : 0u);
+    child = second ? b.child : a.child;
     trail = trail >> 1u;
   }
   return pmf;
