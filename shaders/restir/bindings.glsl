@@ -21,7 +21,8 @@
 
 // The parameters, then the frame's pixels in the order its passes take them (render/pixel_order.h:
 // packed x | y << 16; first those whose camera rays may meet the volume, then the others), then,
-// with emissive surfaces, a bit per pixel (rs_lamp_pixel).
+// with emissive surfaces, a bit per pixel (rs_lamp_pixel) and the list of the pixels whose bit is
+// set (passes/restir_lamps.comp's, render/restir.cpp).
 layout(std430, binding = BIND_RS_PARAMS) readonly buffer RestirParamBuffer {
   RestirParams rsParams;
   uint rsPixels[];
