@@ -152,7 +152,7 @@ class Restir {
   // The frame's pixels, those that may see the volume first (render/pixel_order.h), and the
   // camera and volume they were found for (recomputed and uploaded when either changes).
   PixelOrder pixelOrder_;
-  uint32_t lampPixels_ = 0;  // pixels of the lamp mask (after the order in paramBuffer_), for the log
+  uint32_t lampPixels_ = 0;  // the lamp pass's list (after the order and the mask in paramBuffer_)
   shared::GpuCamera orderCam_{};
   uint64_t orderSerial_ = 0;
   PassTimes passTimes_;
