@@ -362,11 +362,12 @@ void Restir::fillFrame(int frame, uint32_t sequence, uint32_t key) {
     paramBuffer_.upload(pixelOrder_.pixels.data(), pixelOrder_.pixels.size() * sizeof(uint32_t),
                         sizeof(shared::RestirParams));
     if (lamps_) {
-      // The mask, then its pixels in tile order (the lamp pass's list).
+      // The mask, then its pixels in the passes' order (the lamp pass's list; with surfaces every
+      // pixel is inside, so that is tile order).
       std::vector<uint32_t> lamps = options_.cullLampPixels ? emitterPixelMask(cam, w, h, surfaces_->emitterVertices())
                                                             : std::vector<uint32_t>((size_t(w) * h + 31) / 32, ~0u);
       const size_t maskWords = lamps.size();
-      for (uint32_t packed : allPixels(w, h).pixels) {
+      for (uint32_t packed : pixelOrder_.pixels) {
         const size_t i = size_t(packed >> 16) * size_t(w) + (packed & 0xffffu);
         if ((lamps[i / 32] >> (i % 32)) & 1u) lamps.push_back(packed);
       }
