@@ -279,7 +279,9 @@ TEST_F(CityGpuTest, RestirMatchesReferenceOnTheBundledCity) {
 // ReSTIR's lamps seen directly are traced only in the pixels whose camera rays may meet an
 // emitter's front (render/pixel_order.h emitterPixelMask, a pass of their own over them); every
 // other pixel's lamp reservoir would be empty, so the frames equal those of every pixel tracing
-// its 16 rays, bit for bit: the whole city at 40 x 40 (8000 emitters, some under a pixel wide),
+// its 16 rays over the whole pixel (RestirOptions::lampRects off in both: the rectangles draw other
+// rays, tested by PixelOrder.EveryPixelThatSeesAnEmittersFrontIsMarked and the lamps' Z-tests,
+// test_restir_surfaces.cpp), bit for bit: the whole city at 40 x 40 (8000 emitters, some under a pixel wide),
 // four frames with a still camera (the lamp reservoirs' history merged) and four moving (309 and
 // 340 of 1600 pixels traced). Can it fail: with the mask's triangles shrunk to their centroids and
 // no margin (a sabotage of emitterPixelMask: 262 and 268 pixels) 33 and 27 channels differ.
@@ -300,6 +302,7 @@ TEST_F(CityGpuTest, LampPassGivesTheFramesOfEveryPixelTracingItsLamps) {
     auto frames = [&](bool cull, uint32_t& lampPixels) {
       RestirOptions o;
       o.cullLampPixels = cull;
+      o.lampRects = false;
       Restir restir(ctx(), compiler(), *scene, o);
       restir.setVolumes(volume, volume);
       std::vector<Image> out;

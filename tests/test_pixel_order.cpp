@@ -245,11 +245,15 @@ size_t markedCount(const std::vector<uint32_t>& mask, int width, int height) {
 // front is marked (ReSTIR traces the lamps seen directly in those pixels only, so a pixel left out
 // wrongly would lose its lamp). Random cameras and triangles of every size (from a few hundredths
 // of a pixel to larger than the image), facing any way, some across or behind the camera's plane;
-// 24 rays per pixel (its corners, centre and random points) in double precision.
+// 24 rays per pixel (its corners, centre and random points) in double precision. The same for
+// emitterPixelRects: every such ray's (u, v) lies in its pixel's rectangle (the lamp reservoir
+// draws its rays there only, so a point left out would lose its part of the lamp), and the
+// rectangles mark the mask's pixels.
 TEST(PixelOrder, EveryPixelThatSeesAnEmittersFrontIsMarked) {
   std::mt19937 rng(777);
   std::uniform_real_distribution<float> u(-1.0f, 1.0f);
-  size_t missed = 0, hits = 0, marks = 0, pixels = 0;
+  size_t missed = 0, hits = 0, marks = 0, pixels = 0, rays = 0, outsideRect = 0, maskDiffers = 0;
+  double rectArea = 0.0;
   for (int trial = 0; trial < 40; ++trial) {
     const int width = 16 + int(rng() % 40), height = 12 + int(rng() % 40);
     const glm::vec3 position(4.0f * u(rng), 4.0f * u(rng), 4.0f * u(rng));
@@ -265,16 +269,27 @@ TEST(PixelOrder, EveryPixelThatSeesAnEmittersFrontIsMarked) {
     }
     const std::vector<uint32_t> mask = emitterPixelMask(cam, width, height, vertices);
     ASSERT_EQ(mask.size(), (size_t(width) * height + 31) / 32);
+    const std::vector<uint64_t> rects = emitterPixelRects(cam, width, height, vertices);
+    ASSERT_EQ(rects.size(), size_t(width) * height);
     std::uniform_real_distribution<double> w(0.0, 1.0);
     for (int y = 0; y < height; ++y) {
       for (int x = 0; x < width; ++x) {
+        const uint64_t rect = rects[size_t(y) * width + x];
+        const double u0 = double(rect & 0xffffu) / 65535.0, v0 = double(rect >> 16 & 0xffffu) / 65535.0;
+        const double u1 = double(rect >> 32 & 0xffffu) / 65535.0, v1 = double(rect >> 48) / 65535.0;
+        maskDiffers += (rect != kNoEmitterRect) != marked(mask, width, x, y) ? 1 : 0;
+        if (rect != kNoEmitterRect) rectArea += (u1 - u0) * (v1 - v0);
         bool any = false;
-        for (int r = 0; r < 24 && !any; ++r) {
+        for (int r = 0; r < 24; ++r) {
           const double fx = r < 4 ? (r & 1) : r == 4 ? 0.5 : w(rng), fy = r < 4 ? (r >> 1) : r == 4 ? 0.5 : w(rng);
-          for (size_t k = 0; k < vertices.size() && !any; k += 3) {
-            any = rayMeetsFront(cam, width, height, x + fx, y + fy, glm::dvec3(vertices[k]), glm::dvec3(vertices[k + 1]),
+          bool hit = false;
+          for (size_t k = 0; k < vertices.size() && !hit; k += 3) {
+            hit = rayMeetsFront(cam, width, height, x + fx, y + fy, glm::dvec3(vertices[k]), glm::dvec3(vertices[k + 1]),
                                 glm::dvec3(vertices[k + 2]));
           }
+          any = any || hit;
+          rays += hit ? 1 : 0;
+          outsideRect += hit && !(fx >= u0 && fx <= u1 && fy >= v0 && fy <= v1) ? 1 : 0;
         }
         hits += any ? 1 : 0;
         missed += any && !marked(mask, width, x, y) ? 1 : 0;
@@ -283,9 +298,14 @@ TEST(PixelOrder, EveryPixelThatSeesAnEmittersFrontIsMarked) {
     marks += markedCount(mask, width, height);
     pixels += size_t(width) * height;
   }
-  std::printf("[pixel order] emitters: %zu of %zu pixels see a front, %zu marked, %zu missed\n", hits, pixels, marks,
-              missed);
+  std::printf("[pixel order] emitters: %zu of %zu pixels see a front, %zu marked, %zu missed; %zu rays meet a front, "
+              "%zu outside their pixel's rectangle; the rectangles cover %.3f of a marked pixel on average\n",
+              hits, pixels, marks, missed, rays, outsideRect, rectArea / double(marks));
   EXPECT_EQ(missed, 0u) << "a pixel that sees an emitter's front must be marked";
+  EXPECT_EQ(outsideRect, 0u) << "a ray that meets an emitter's front must lie in its pixel's rectangle";
+  EXPECT_EQ(maskDiffers, 0u) << "the rectangles must mark the mask's pixels";
+  // (Most of these triangles are larger than a pixel: the rectangles leave out about a tenth.)
+  EXPECT_LT(rectArea, 0.95 * double(marks)) << "the rectangles must leave parts of the pixels out";
   EXPECT_GT(hits, pixels / 20) << "too few pixels see an emitter for the test to mean much";
   EXPECT_LT(marks, pixels * 3 / 4) << "the mask must leave pixels out";
 }
@@ -315,6 +335,17 @@ TEST(PixelOrder, EmitterMaskLeavesOutBacksAndTheUnseen) {
   const std::vector<uint32_t> one = emitterPixelMask(cam, width, height, {c + glm::vec3(-h, -h, 0.0f), c + glm::vec3(h, -h, 0.0f), c + glm::vec3(0.0f, h, 0.0f)});
   EXPECT_EQ(markedCount(one, width, height), 1u);
   EXPECT_TRUE(marked(one, width, 10, 7));
+  // Its rectangle: the hundredth of a pixel around the centre grown by the margin on each side.
+  const std::vector<uint64_t> rects = emitterPixelRects(cam, width, height, {c + glm::vec3(-h, -h, 0.0f), c + glm::vec3(h, -h, 0.0f), c + glm::vec3(0.0f, h, 0.0f)});
+  const uint64_t r = rects[7 * width + 10];
+  const double u0 = double(r & 0xffffu) / 65535.0, v0 = double(r >> 16 & 0xffffu) / 65535.0;
+  const double u1 = double(r >> 32 & 0xffffu) / 65535.0, v1 = double(r >> 48) / 65535.0;
+  const double m = kEmitterPixelMargin + 0.006;
+  EXPECT_NEAR(u0, 0.5 - m, 0.002);
+  EXPECT_NEAR(u1, 0.5 + m, 0.002);
+  EXPECT_NEAR(v0, 0.5 - m, 0.002);
+  EXPECT_NEAR(v1, 0.5 + m, 0.002);
+  EXPECT_EQ(std::count(rects.begin(), rects.end(), kNoEmitterRect), std::ptrdiff_t(width * height - 1));
 }
 
 }  // namespace

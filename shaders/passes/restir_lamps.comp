@@ -1,7 +1,8 @@
 // ReSTIR's lamps seen directly (restir/candidates.glsl rs_lamp_reservoir): the lamp reservoir of
 // every pixel in the list whose camera rays may meet an emitter's front (render/pixel_order.h
-// emitterPixelMask), dense, so that a subgroup's lanes all trace; the candidates pass writes the
-// others' empty reservoirs. Only for scenes with emissive surfaces.
+// emitterPixelRects), dense, so that a subgroup's lanes all trace, its rays drawn in the part of
+// the pixel where they may; the candidates pass writes the others' empty reservoirs. Only for
+// scenes with emissive surfaces.
 #version 450
 #extension GL_GOOGLE_include_directive : require
 
@@ -17,6 +18,8 @@ void main() {
   uvec2 pixel;
   if (!rs_dispatch_pixel(pixel)) return;
   RngState rng = rng_init(pixel, frame.frameKey, RNG_STREAM_CANDIDATES, frame.seed);
-  rs_lamp_reservoir(rs_current_domain(pixel), pixel.y * frame.size.x + pixel.x, rng);
+  vec2 lo, hi;
+  rs_lamp_rect(lo, hi);
+  rs_lamp_reservoir(rs_current_domain(pixel), pixel.y * frame.size.x + pixel.x, lo, hi, rng);
   loop_guard_check(frame.loopProbe);
 }

@@ -67,6 +67,15 @@ layout(push_constant) uniform PushBlock { RsPush push; };
 // after the pixel list (render/pixel_order.h emitterPixelMask; with emissive surfaces only).
 bool rs_lamp_pixel(uint index) { return ((rsPixels[rsp.pixelCount + (index >> 5u)] >> (index & 31u)) & 1u) != 0u; }
 
+// The rectangle [lo, hi] of the (u, v) of the lamp pass's pixel where its camera rays may meet an
+// emitter's front: the two words after the list's end for each of its pixels (render/pixel_order.h
+// emitterPixelRects, rounded outwards; [0, 1]² for every pixel without RestirOptions::lampRects).
+void rs_lamp_rect(out vec2 lo, out vec2 hi) {
+  uint i = push.listBegin + push.listCount + 2u * gl_GlobalInvocationID.x;
+  lo = unpackUnorm2x16(rsPixels[i]);
+  hi = unpackUnorm2x16(rsPixels[i + 1u]);
+}
+
 // The pixel of this invocation of a dispatch over rsPixels[push.listBegin ..][.. push.listCount]
 // (one-dimensional workgroups); false past the list's end.
 bool rs_dispatch_pixel(out uvec2 pixel) {

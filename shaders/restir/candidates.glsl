@@ -88,10 +88,12 @@ float rs_lamp_target(RsDomain D, uint v, uint uv) {
 }
 
 // The frame's lamp reservoir of the pixel (set rsp.lampSet): RS_DIRECT_RAYS candidates, ray i
-// uniform on cell i of a RS_DIRECT_SIDE² grid of the pixel (density RS_DIRECT_RAYS there; MIS
-// weights "1 if (u, v) lies in cell i", a partition of the pixel), confidence 1 in all. The
-// candidates are resampled by Le alone, p̂' (u, v) (candidate i's weight p̂'(u_i, v_i) /
-// RS_DIRECT_RAYS), so that W = w_sum / p̂'(Y) is an unbiased contribution weight of the selected
+// uniform on cell i of a RS_DIRECT_SIDE² grid of the rectangle [lo, hi] of the pixel outside
+// which no camera ray meets an emitter's front (rs_lamp_rect; p̂ is 0 outside it), density
+// RS_DIRECT_RAYS / A there (A its area; MIS weights "1 if (u, v) lies in cell i", a partition of
+// the rectangle), confidence 1 in all: a lamp a tenth of a pixel across gets all the rays, not
+// one in six. The candidates are resampled by Le alone, p̂' (u, v) (candidate i's weight
+// p̂'(u_i, v_i) A / RS_DIRECT_RAYS), so that W = w_sum / p̂'(Y) is an unbiased contribution weight of the selected
 // Y (GRIS: any target of the candidates' own resampling gives one); the reservoir's p̂ is the
 // target with the smoke's transmittance, evaluated once for Y, and the merge below and final
 // shading use that W with it. One mean-field walk a pixel instead of one per ray that meets a
@@ -112,17 +114,19 @@ const uint RS_LAMP_DRAWS = 2u * RS_DIRECT_RAYS;  // (u, v) and the selection, pe
 
 uint rs_lamp_draws() { return RS_LAMP_DRAWS + (rsp.lampHistory != 0u ? 2u : 0u); }
 
-void rs_lamp_reservoir(RsDomain D, uint pixelIndex, inout RngState rng) {
+void rs_lamp_reservoir(RsDomain D, uint pixelIndex, vec2 lo, vec2 hi, inout RngState rng) {
   RsReservoir r = rs_empty();
   uint uv = 0u;
   vec3 dirY = vec3(0.0f);  // the selected ray's direction and hit distance
   float tY = 0.0f;
+  vec2 extent = hi - lo;
+  float cellWeight = extent.x * extent.y * (1.0f / float(RS_DIRECT_RAYS));  // 1 / the density on the cell
   for (uint i = 0u; i < RS_DIRECT_RAYS; ++i) {
-    uint c = rs_pack_uv(rs_direct_uv(i, rng_float2(rng)));
+    uint c = rs_pack_uv(lo + extent * rs_direct_uv(i, rng_float2(rng)));
     vec3 dir;
     float t;
     float ph = rs_lamp_emitted(D, c, dir, t);
-    if (rs_update(r, ph * (1.0f / float(RS_DIRECT_RAYS)), ph, 0.0f, rng_float(rng))) {
+    if (rs_update(r, ph * cellWeight, ph, 0.0f, rng_float(rng))) {
       uv = c;
       dirY = dir;
       tY = t;

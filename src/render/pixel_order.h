@@ -66,6 +66,17 @@ constexpr double kEmitterPixelMargin = 1.0 / 16.0;
 std::vector<uint32_t> emitterPixelMask(const shared::GpuCamera& cam, int width, int height,
                                        const std::vector<glm::vec3>& vertices);
 
+// The same, finer: per pixel (y * width + x), the rectangle of its square, in its own (u, v) in
+// [0, 1]² (u right, v down, as restir/bridge.glsl's domains), where its camera rays may meet an
+// emitter's front: the union over the triangles of the part of their grown bounding rectangles
+// inside the pixel, rounded outwards to 16-bit fixed point and packed as packUnorm2x16 would,
+// (u0, v0) in the low word and (u1, v1) in the high word (restir/candidates.glsl draws the lamp
+// reservoir's rays in it). kNoEmitterRect where no triangle marks the pixel.
+constexpr uint64_t kNoEmitterRect = 0xffffu | uint64_t(0xffffu) << 16;  // u0 = v0 = 1 > u1 = v1 = 0
+constexpr uint64_t kWholePixelRect = uint64_t(0xffffffffu) << 32;      // [0, 1]²
+std::vector<uint64_t> emitterPixelRects(const shared::GpuCamera& cam, int width, int height,
+                                        const std::vector<glm::vec3>& vertices);
+
 inline uint32_t packPixel(uint32_t x, uint32_t y) { return x | y << 16; }
 
 }  // namespace plume

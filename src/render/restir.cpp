@@ -240,9 +240,9 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   const size_t choices = std::max(lights.size(), scene.lights.size() + (features_.emitters ? 1 : 0));
   lightChoice_ = gpu::Buffer(ctx, choices * sizeof(shared::GpuLightChoice), storage, "light choice");
   // The parameters, then the frame's pixels in the passes' order, then with emissive surfaces a
-  // bit per pixel, set where its camera rays may meet an emitter, and those pixels' list
-  // (restir/bindings.glsl rsPixels, rs_lamp_pixel).
-  const size_t lampWords = features_.emitters ? (pixels + 31) / 32 + pixels : 0;
+  // bit per pixel, set where its camera rays may meet an emitter, those pixels' list and their
+  // rectangles, two words each (restir/bindings.glsl rsPixels, rs_lamp_pixel, rs_lamp_rect).
+  const size_t lampWords = features_.emitters ? (pixels + 31) / 32 + 3 * pixels : 0;
   paramBuffer_ = gpu::Buffer(ctx, sizeof(shared::RestirParams) + (pixels + lampWords) * sizeof(uint32_t), storage,
                              "restir parameters");
   static_assert(sizeof(shared::RsPacked) == 16 && sizeof(shared::RsPathHead) == 32);  // 1 and 2 texels
@@ -363,15 +363,24 @@ void Restir::fillFrame(int frame, uint32_t sequence, uint32_t key) {
                         sizeof(shared::RestirParams));
     if (lamps_) {
       // The mask, then its pixels in the passes' order (the lamp pass's list; with surfaces every
-      // pixel is inside, so that is tile order).
-      std::vector<uint32_t> lamps = options_.cullLampPixels ? emitterPixelMask(cam, w, h, surfaces_->emitterVertices())
-                                                            : std::vector<uint32_t>((size_t(w) * h + 31) / 32, ~0u);
+      // pixel is inside, so that is tile order), then their rectangles in the list's order.
+      const size_t n = size_t(w) * size_t(h);
+      std::vector<uint64_t> rects = options_.cullLampPixels ? emitterPixelRects(cam, w, h, surfaces_->emitterVertices())
+                                                            : std::vector<uint64_t>(n, kWholePixelRect);
+      std::vector<uint32_t> lamps((n + 31) / 32, 0u);
+      for (size_t i = 0; i < n; ++i)
+        if (rects[i] != kNoEmitterRect) lamps[i / 32] |= 1u << (i % 32);
       const size_t maskWords = lamps.size();
+      std::vector<uint64_t> listRects;
       for (uint32_t packed : pixelOrder_.pixels) {
         const size_t i = size_t(packed >> 16) * size_t(w) + (packed & 0xffffu);
-        if ((lamps[i / 32] >> (i % 32)) & 1u) lamps.push_back(packed);
+        if ((lamps[i / 32] >> (i % 32)) & 1u) {
+          lamps.push_back(packed);
+          listRects.push_back(options_.lampRects ? rects[i] : kWholePixelRect);
+        }
       }
       lampPixels_ = uint32_t(lamps.size() - maskWords);
+      for (uint64_t r : listRects) lamps.insert(lamps.end(), {uint32_t(r), uint32_t(r >> 32)});
       paramBuffer_.upload(lamps.data(), lamps.size() * sizeof(uint32_t),
                           sizeof(shared::RestirParams) + pixelOrder_.pixels.size() * sizeof(uint32_t));
     }

@@ -62,6 +62,10 @@ struct RestirOptions {
   // whose rays may meet an emitter's front (render/pixel_order.h emitterPixelMask; the others'
   // reservoirs are empty either way); the two must give one image, bit for bit.
   bool cullLampPixels = true;
+  // Tests only: false draws the lamp reservoir's camera rays over the whole of each pixel,
+  // instead of over the rectangle of it where an emitter's front may be seen
+  // (render/pixel_order.h emitterPixelRects); same expectation, other images.
+  bool lampRects = true;
   // Tests only: true keeps the stored paths' vertices in a storage buffer (PLUME_RS_VERTEX_BUFFER)
   // as on a device whose texel buffers cannot hold them but whose storage buffers can (otherwise
   // the device's limits choose: Restir::Restir); the two must give one image, bit for bit.
