@@ -241,6 +241,14 @@ size_t markedCount(const std::vector<uint32_t>& mask, int width, int height) {
   return n;
 }
 
+// A packed rectangle of emitterPixelRects: (u0, v0) and (u1, v1).
+struct UnpackedRect {
+  double u0, v0, u1, v1;
+  explicit UnpackedRect(uint64_t r)
+      : u0(double(r & 0xffffu) / 65535.0), v0(double(r >> 16 & 0xffffu) / 65535.0),
+        u1(double(r >> 32 & 0xffffu) / 65535.0), v1(double(r >> 48) / 65535.0) {}
+};
+
 // render/pixel_order.h emitterPixelMask: every pixel one of whose camera rays meets an emitter's
 // front is marked (ReSTIR traces the lamps seen directly in those pixels only, so a pixel left out
 // wrongly would lose its lamp). Random cameras and triangles of every size (from a few hundredths
@@ -275,10 +283,9 @@ TEST(PixelOrder, EveryPixelThatSeesAnEmittersFrontIsMarked) {
     for (int y = 0; y < height; ++y) {
       for (int x = 0; x < width; ++x) {
         const uint64_t rect = rects[size_t(y) * width + x];
-        const double u0 = double(rect & 0xffffu) / 65535.0, v0 = double(rect >> 16 & 0xffffu) / 65535.0;
-        const double u1 = double(rect >> 32 & 0xffffu) / 65535.0, v1 = double(rect >> 48) / 65535.0;
+        const UnpackedRect q(rect);
         maskDiffers += (rect != kNoEmitterRect) != marked(mask, width, x, y) ? 1 : 0;
-        if (rect != kNoEmitterRect) rectArea += (u1 - u0) * (v1 - v0);
+        if (rect != kNoEmitterRect) rectArea += (q.u1 - q.u0) * (q.v1 - q.v0);
         bool any = false;
         for (int r = 0; r < 24; ++r) {
           const double fx = r < 4 ? (r & 1) : r == 4 ? 0.5 : w(rng), fy = r < 4 ? (r >> 1) : r == 4 ? 0.5 : w(rng);
@@ -289,7 +296,7 @@ TEST(PixelOrder, EveryPixelThatSeesAnEmittersFrontIsMarked) {
           }
           any = any || hit;
           rays += hit ? 1 : 0;
-          outsideRect += hit && !(fx >= u0 && fx <= u1 && fy >= v0 && fy <= v1) ? 1 : 0;
+          outsideRect += hit && !(fx >= q.u0 && fx <= q.u1 && fy >= q.v0 && fy <= q.v1) ? 1 : 0;
         }
         hits += any ? 1 : 0;
         missed += any && !marked(mask, width, x, y) ? 1 : 0;
@@ -337,14 +344,12 @@ TEST(PixelOrder, EmitterMaskLeavesOutBacksAndTheUnseen) {
   EXPECT_TRUE(marked(one, width, 10, 7));
   // Its rectangle: the hundredth of a pixel around the centre grown by the margin on each side.
   const std::vector<uint64_t> rects = emitterPixelRects(cam, width, height, {c + glm::vec3(-h, -h, 0.0f), c + glm::vec3(h, -h, 0.0f), c + glm::vec3(0.0f, h, 0.0f)});
-  const uint64_t r = rects[7 * width + 10];
-  const double u0 = double(r & 0xffffu) / 65535.0, v0 = double(r >> 16 & 0xffffu) / 65535.0;
-  const double u1 = double(r >> 32 & 0xffffu) / 65535.0, v1 = double(r >> 48) / 65535.0;
+  const UnpackedRect q(rects[7 * width + 10]);
   const double m = kEmitterPixelMargin + 0.006;
-  EXPECT_NEAR(u0, 0.5 - m, 0.002);
-  EXPECT_NEAR(u1, 0.5 + m, 0.002);
-  EXPECT_NEAR(v0, 0.5 - m, 0.002);
-  EXPECT_NEAR(v1, 0.5 + m, 0.002);
+  EXPECT_NEAR(q.u0, 0.5 - m, 0.002);
+  EXPECT_NEAR(q.u1, 0.5 + m, 0.002);
+  EXPECT_NEAR(q.v0, 0.5 - m, 0.002);
+  EXPECT_NEAR(q.v1, 0.5 + m, 0.002);
   EXPECT_EQ(std::count(rects.begin(), rects.end(), kNoEmitterRect), std::ptrdiff_t(width * height - 1));
 }
 
