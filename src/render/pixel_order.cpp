@@ -154,15 +154,11 @@ PixelOrder volumePixelOrder(const shared::GpuCamera& cam, int width, int height,
   return order;
 }
 
-namespace {
-
-// Calls mark(x, y, u0, v0, u1, v1) for every pixel the grown bounding rectangle of an emissive
-// triangle's projection meets (emitterPixelMask), with the part of the rectangle inside it in the
-// pixel's (u, v); stops early and returns false when a projection is not a number.
-template <typename F>
-bool forEachEmitterPixel(const shared::GpuCamera& cam, int width, int height, const std::vector<glm::vec3>& vertices,
-                         F&& mark) {
+std::vector<uint64_t> emitterPixelRects(const shared::GpuCamera& cam, int width, int height,
+                                        const std::vector<glm::vec3>& vertices) {
   PLUME_CHECK(width > 0 && height > 0 && width <= 65536 && height <= 65536 && vertices.size() % 3 == 0);
+  std::vector<uint64_t> rects(size_t(width) * size_t(height), kNoEmitterRect);
+  auto fixed = [](double t, bool up) { return uint64_t(up ? std::ceil(t * 65535.0) : std::floor(t * 65535.0)); };
   const glm::dvec3 pos(cam.position), fwd(cam.forward), right(cam.right), up(cam.up);
   const double tanY = double(cam.tanHalfFovY), tanX = tanY * double(cam.aspect);
   for (size_t k = 0; k < vertices.size(); k += 3) {
@@ -198,8 +194,12 @@ bool forEachEmitterPixel(const shared::GpuCamera& cam, int width, int height, co
       ymin = std::min(ymin, py);
       ymax = std::max(ymax, py);
     }
-    if (!(std::isfinite(xmin) && std::isfinite(xmax) && std::isfinite(ymin) && std::isfinite(ymax))) return false;
-    // The pixels [x0, x1) x [y0, y1) whose squares meet the rectangle grown by the margin.
+    if (!(std::isfinite(xmin) && std::isfinite(xmax) && std::isfinite(ymin) && std::isfinite(ymax))) {
+      std::fill(rects.begin(), rects.end(), kWholePixelRect);  // (not a number: every pixel, whole)
+      break;
+    }
+    // The pixels [x0, x1) x [y0, y1) whose squares meet the rectangle grown by the margin, and its
+    // part inside each.
     const double m = kEmitterPixelMargin;
     xmin -= m, xmax += m, ymin -= m, ymax += m;
     const int x0 = int(std::clamp(std::floor(xmin), 0.0, double(width)));
@@ -208,40 +208,23 @@ bool forEachEmitterPixel(const shared::GpuCamera& cam, int width, int height, co
     const int y1 = int(std::clamp(std::floor(ymax) + 1.0, 0.0, double(height)));
     for (int y = y0; y < y1; ++y) {
       for (int x = x0; x < x1; ++x) {
-        mark(x, y, std::clamp(xmin - x, 0.0, 1.0), std::clamp(ymin - y, 0.0, 1.0), std::clamp(xmax - x, 0.0, 1.0),
-             std::clamp(ymax - y, 0.0, 1.0));
+        uint64_t& r = rects[size_t(y) * size_t(width) + size_t(x)];
+        const uint64_t a = std::min(r & 0xffffu, fixed(std::clamp(xmin - x, 0.0, 1.0), false));
+        const uint64_t b = std::min(r >> 16 & 0xffffu, fixed(std::clamp(ymin - y, 0.0, 1.0), false));
+        const uint64_t c = std::max(r >> 32 & 0xffffu, fixed(std::clamp(xmax - x, 0.0, 1.0), true));
+        const uint64_t d = std::max(r >> 48, fixed(std::clamp(ymax - y, 0.0, 1.0), true));
+        r = a | b << 16 | c << 32 | d << 48;
       }
     }
   }
-  return true;
-}
-
-}  // namespace
-
-std::vector<uint32_t> emitterPixelMask(const shared::GpuCamera& cam, int width, int height,
-                                       const std::vector<glm::vec3>& vertices) {
-  const size_t n = size_t(width) * size_t(height);
-  std::vector<uint32_t> mask((n + 31) / 32, 0u);
-  const bool ok = forEachEmitterPixel(cam, width, height, vertices, [&](int x, int y, double, double, double, double) {
-    const size_t i = size_t(y) * size_t(width) + size_t(x);
-    mask[i / 32] |= 1u << (i % 32);
-  });
-  if (!ok) std::fill(mask.begin(), mask.end(), ~0u);  // (not a number: every pixel)
-  return mask;
-}
-
-std::vector<uint64_t> emitterPixelRects(const shared::GpuCamera& cam, int width, int height,
-                                        const std::vector<glm::vec3>& vertices) {
-  std::vector<uint64_t> rects(size_t(width) * size_t(height), kNoEmitterRect);
-  auto fixed = [](double t, bool up) { return uint64_t(up ? std::ceil(t * 65535.0) : std::floor(t * 65535.0)); };
-  const bool ok = forEachEmitterPixel(cam, width, height, vertices, [&](int x, int y, double u0, double v0, double u1, double v1) {
-    uint64_t& r = rects[size_t(y) * size_t(width) + size_t(x)];
-    const uint64_t a = std::min(r & 0xffffu, fixed(u0, false)), b = std::min(r >> 16 & 0xffffu, fixed(v0, false));
-    const uint64_t c = std::max(r >> 32 & 0xffffu, fixed(u1, true)), d = std::max(r >> 48, fixed(v1, true));
-    r = a | b << 16 | c << 32 | d << 48;
-  });
-  if (!ok) std::fill(rects.begin(), rects.end(), kWholePixelRect);
   return rects;
+}
+
+std::vector<uint32_t> emitterPixelMask(const std::vector<uint64_t>& rects) {
+  std::vector<uint32_t> mask((rects.size() + 31) / 32, 0u);
+  for (size_t i = 0; i < rects.size(); ++i)
+    if (rects[i] != kNoEmitterRect) mask[i / 32] |= 1u << (i % 32);
+  return mask;
 }
 
 }  // namespace plume

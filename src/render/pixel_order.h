@@ -53,29 +53,27 @@ PixelOrder volumePixelOrder(const shared::GpuCamera& cam, int width, int height,
 // Every pixel, in tile order, all inside.
 PixelOrder allPixels(int width, int height);
 
-// The pixels of a width x height image seen by the pinhole camera `cam` whose rays may meet the
+// Where the camera rays of a width x height image seen by the pinhole camera `cam` may meet the
 // front of an emissive triangle (`vertices`: three world-space corners per triangle; the front is
-// the side its corners' counter-clockwise normal points to, where surf_emitted emits): bit
-// (y * width + x) % 32 of word (y * width + x) / 32 (ReSTIR's lamp reservoir traces its camera
-// rays in those pixels only: restir/candidates.glsl). Conservative: a triangle is left out only
-// when the camera is behind its plane or it lies wholly behind the camera's plane; the rest mark
-// the bounding rectangle of their projection (clipped to the front of the camera's plane) grown
-// by kEmitterPixelMargin pixels (a device's rounding of a camera ray is below 10^-5 pixels at
-// 8192 pixels across; a lamp smaller than a pixel should mark one or two in each direction, not three).
+// the side its corners' counter-clockwise normal points to, where surf_emitted emits): per pixel
+// (y * width + x), the rectangle of its square, in its own (u, v) in [0, 1]² (u right, v down, as
+// restir/bridge.glsl's domains), rounded outwards to 16-bit fixed point and packed as
+// packUnorm2x16 would, (u0, v0) in the low word and (u1, v1) in the high word; kNoEmitterRect
+// where no triangle may be seen (ReSTIR's lamp reservoir traces its camera rays in those pixels
+// only, and in each only in its rectangle: restir/candidates.glsl). Conservative: a triangle is
+// left out only when the camera is behind its plane or it lies wholly behind the camera's plane;
+// the rest contribute the bounding rectangle of their projection (clipped to the front of the
+// camera's plane) grown by kEmitterPixelMargin pixels (a device's rounding of a camera ray is
+// below 10^-5 pixels at 8192 pixels across; a lamp smaller than a pixel should mark one or two
+// pixels in each direction, not three), a pixel's rectangle the union of their parts inside it.
 constexpr double kEmitterPixelMargin = 1.0 / 16.0;
-std::vector<uint32_t> emitterPixelMask(const shared::GpuCamera& cam, int width, int height,
-                                       const std::vector<glm::vec3>& vertices);
-
-// The same, finer: per pixel (y * width + x), the rectangle of its square, in its own (u, v) in
-// [0, 1]² (u right, v down, as restir/bridge.glsl's domains), where its camera rays may meet an
-// emitter's front: the union over the triangles of the part of their grown bounding rectangles
-// inside the pixel, rounded outwards to 16-bit fixed point and packed as packUnorm2x16 would,
-// (u0, v0) in the low word and (u1, v1) in the high word (restir/candidates.glsl draws the lamp
-// reservoir's rays in it). kNoEmitterRect where no triangle marks the pixel.
 constexpr uint64_t kNoEmitterRect = 0xffffu | uint64_t(0xffffu) << 16;  // u0 = v0 = 1 > u1 = v1 = 0
 constexpr uint64_t kWholePixelRect = uint64_t(0xffffffffu) << 32;      // [0, 1]²
 std::vector<uint64_t> emitterPixelRects(const shared::GpuCamera& cam, int width, int height,
                                         const std::vector<glm::vec3>& vertices);
+
+// The pixels that have a rectangle: bit i % 32 of word i / 32 for pixel i = y * width + x.
+std::vector<uint32_t> emitterPixelMask(const std::vector<uint64_t>& rects);
 
 inline uint32_t packPixel(uint32_t x, uint32_t y) { return x | y << 16; }
 

@@ -367,9 +367,7 @@ void Restir::fillFrame(int frame, uint32_t sequence, uint32_t key) {
       const size_t n = size_t(w) * size_t(h);
       std::vector<uint64_t> rects = options_.cullLampPixels ? emitterPixelRects(cam, w, h, surfaces_->emitterVertices())
                                                             : std::vector<uint64_t>(n, kWholePixelRect);
-      std::vector<uint32_t> lamps((n + 31) / 32, 0u);
-      for (size_t i = 0; i < n; ++i)
-        if (rects[i] != kNoEmitterRect) lamps[i / 32] |= 1u << (i % 32);
+      std::vector<uint32_t> lamps = emitterPixelMask(rects);
       const size_t maskWords = lamps.size();
       std::vector<uint64_t> listRects;
       for (uint32_t packed : pixelOrder_.pixels) {
