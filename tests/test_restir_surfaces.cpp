@@ -67,6 +67,15 @@ TEST_F(GpuRestirSurfaces, LampsSeenDirectlyMatchReference) {
   reuse.historyCap = 20;
   test::expectRestirMatchesReference(ctx(), compiler(), s, grid, 256, 16384, "lamps_seen_directly_history",
                                      {shared::RS_MIS_PAIRWISE, shared::RS_MIS_GBH}, reuse, 3);
+  // A still view's long history (session 32): no spatial reuse where nothing changed, and a history
+  // whose cap is longer there than the plain one (1 x M here, so frame 3's history holds
+  // two frames' candidates only under restir_history_cap_static); the lamp reservoirs' too.
+  RestirOptions still = reuse;
+  still.roundsStatic = 0;
+  still.historyCap = 1;
+  still.historyCapStatic = 20;
+  test::expectRestirMatchesReference(ctx(), compiler(), s, grid, 256, 16384, "lamps_seen_directly_static_history",
+                                     {shared::RS_MIS_PAIRWISE}, still, 3);
   // 512 runs for the one-frame pass: with two spatial neighbours 128 runs left one pixel at z
   // -4.72 (512: -2.84; notes/restir.md "Session 25").
   test::expectRestirMatchesReference(ctx(), compiler(), s, grid, 512, 16384, "lamps_seen_directly_one_frame",

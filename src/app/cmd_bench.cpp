@@ -75,7 +75,8 @@ void addBenchCommand(CLI::App& app, Action& action) {
   cmd->add_option("--height", args->height, "image height (default 64)")->check(CLI::Range(1, 16384));
   cmd->add_option("--warmup", args->options.warmup,
                   "frames before measuring (default: the ReSTIR variants' largest history cap c, at least 4: the "
-                  "frames temporal reuse needs to reach steady state)")
+                  "frames temporal reuse needs to reach steady state; the static camera's run counts "
+                  "restir_history_cap_static too)")
       ->check(CLI::Range(0, 1000));
   cmd->add_option("--measure", args->options.frames, "measured frames")->check(CLI::Range(1, 1000));
   cmd->add_option("--frame", args->options.gridFrame, "animation frame whose grid is held still (default: the scene's first)")

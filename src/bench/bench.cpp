@@ -113,6 +113,10 @@ Image loadOrBuildReference(gpu::Context& ctx, gpu::ShaderCompiler& compiler, con
   return ref;
 }
 
+// Warm-up frames the path tracer renders (before the measured ones, for its caches and pipelines;
+// its frames are independent, so the rest of a long ReSTIR warm-up is not rendered).
+constexpr int kPathTracerWarmup = 4;
+
 // A ReSTIR variant as the render settings that select it (mode restir-biased for RS_MIS_BIASED).
 RenderSettings withRestir(RenderSettings rs, const RestirOptions& v) {
   rs.mode = v.mis == shared::RS_MIS_BIASED ? "restir-biased" : "restir";
@@ -122,8 +126,10 @@ RenderSettings withRestir(RenderSettings rs, const RestirOptions& v) {
   rs.restirNeighbours = v.neighbours;
   rs.restirRadius = v.radius;
   rs.restirRounds = v.rounds;
+  rs.restirRoundsStatic = v.roundsStatic;
   rs.restirHistoryCap = v.historyCap;
   rs.restirHistoryCapMoving = v.historyCapMoving;
+  rs.restirHistoryCapStatic = v.historyCapStatic;
   rs.restirPrefix = v.prefix;
   rs.restirLightCandidates = v.lightCandidates;
   rs.restirShift = v.reconnect ? "reconnect" : "copy";
@@ -200,16 +206,20 @@ BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Sce
     });
     if (variants.empty()) throw InputError("bench: no ReSTIR variant matches --only");
   }
-  // Warm-up: enough frames for every variant's history to reach its cap (BenchOptions::warmup).
-  if (o.warmup < 0) {
-    o.warmup = 4;
-    for (const auto& [name, v] : variants) o.warmup = std::max(o.warmup, v.historyCap);
-  }
-  result.warmup = o.warmup;
+  // Warm-up: enough frames for every variant's history to reach its cap (BenchOptions::warmup),
+  // each camera's own: a still camera over the still grid runs under the static cap where one is
+  // set, a moving one under the still camera's (each frame's own moving cap is at most that).
+  auto warmupOf = [&](bool moving) {
+    if (o.warmup >= 0) return o.warmup;
+    int w = 4;
+    for (const auto& [name, v] : variants) w = std::max({w, v.historyCap, moving ? 0 : v.historyCapStatic});
+    return w;
+  };
+  result.warmup = warmupOf(false);
+  result.warmupMoving = warmupOf(true);
   // One frame's grid (the first of the scene's range unless chosen), held still: the bench measures
   // the estimators, not the animation. Frame numbers count from it.
   const int first = o.gridFrame >= 0 ? o.gridFrame : scene.render.frameFirst;
-  const int last = first + o.warmup + o.frames - 1;
   VolumeSource volumes(ctx, scene.medium(), {});
   const GpuVolumeResources& volume = volumes.load(first);
   // The CPU reference's grids of the same frame, sanitised and clamped as `plume reference` does.
@@ -226,9 +236,11 @@ BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Sce
   for (const bool moving : {false, true}) {
     const std::string cam = moving ? "moving" : "static";
     if (std::find(o.cameras.begin(), o.cameras.end(), cam) == o.cameras.end()) continue;
+    const int warmupFrames = moving ? result.warmupMoving : result.warmup;
+    const int last = first + warmupFrames + o.frames - 1;
     Scene s = withCamera(scene, moving, first, last, o.orbitDegPerFrame);
     std::map<int, Image> refs;
-    for (int f = first + o.warmup; f <= last; ++f) {
+    for (int f = first + warmupFrames; f <= last; ++f) {
       if (!moving && !refs.empty()) break;
       refs[f] = loadOrBuildReference(ctx, compiler, s, volume, f, o.refSpp, cam);
       result.referenceRelMse = std::max(result.referenceRelMse, referenceOwnRelMse(refs[f]));
@@ -265,7 +277,7 @@ BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Sce
     // Alternating: every method renders frame f before any renders f + 1.
     for (int f = first; f <= last; ++f) {
       for (Method& m : methods) {
-        const bool warmup = f < first + o.warmup;  // rendered, not read back
+        const bool warmup = f < first + warmupFrames;  // rendered, not read back
         Image im;
         double ms = 0;
         if (m.cpuFrame) {
@@ -274,6 +286,8 @@ BenchResult runBench(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Sce
           im = m.cpuFrame(f);
           ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         } else {
+          // The path tracer has no history either: its last few warm-up frames warm its caches.
+          if (m.pathTracer && f < first + warmupFrames - kPathTracerWarmup) continue;
           m.estimator->renderFrame(f, m.spp, {});
           if (warmup) continue;
           im = m.estimator->readImage();

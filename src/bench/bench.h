@@ -21,7 +21,8 @@ namespace plume {
 struct BenchOptions {
   // Frames before measuring, so that temporal reuse reaches steady state: -1 (the default) takes
   // the largest history cap c of the ReSTIR variants run (one iteration per frame adds M to a
-  // history capped at c * M, so after c frames it is full), at least 4.
+  // history capped at c * M, so after c frames it is full), at least 4; with a still camera the
+  // static cap too (restir_history_cap_static).
   int warmup = -1;
   int frames = 6;          // measured frames
   int gridFrame = -1;      // the animation frame whose grid is held still (-1: the scene's first)
@@ -50,7 +51,8 @@ struct BenchRow {
 struct BenchResult {
   std::vector<BenchRow> rows;
   double referenceRelMse = 0;  // estimated from the reference's own variance (worst frame)
-  int warmup = 0;              // frames rendered before measuring (BenchOptions::warmup resolved)
+  int warmup = 0;              // frames rendered before measuring (BenchOptions::warmup resolved): static camera
+  int warmupMoving = 0;        // ... moving camera
   std::string device;
   std::string markdown, csvPath, svgPath, mdPath;
 };

@@ -81,11 +81,12 @@ std::string svgPlot(const std::vector<BenchRow>& rows, const std::string& title)
 
 void writeBenchReport(BenchResult& result, const Scene& scene, const BenchOptions& o, int first, const std::string& dir) {
   std::string md = strf("Device: %s. Scene: %s, %dx%d, max_bounces %d, the grid of frame %d held still. Seed %lld. Warm-up %d "
-                        "frames, %d measured; medians. Converged image: GPU path tracer, %d spp (own relMSE <= %.2g). ms/frame: GPU "
+                        "frames%s, %d measured; medians. Converged image: GPU path tracer, %d spp (own relMSE <= %.2g). ms/frame: GPU "
                         "timestamps; the CPU reference's rows (`reference N spp`, its own seed): wall time, on the "
                         "host's cores.\n\n",
                         result.device.c_str(), scene.path.c_str(), scene.camera.width, scene.camera.height,
-                        scene.render.maxBounces, first, (long long)scene.render.seed, o.warmup,
+                        scene.render.maxBounces, first, (long long)scene.render.seed, result.warmup,
+                        result.warmupMoving != result.warmup ? strf(" (moving camera: %d)", result.warmupMoving).c_str() : "",
                         o.frames, o.refSpp, result.referenceRelMse);
   md += "| camera | method | ms/frame | relMSE | PT relMSE at equal time | gain vs PT | per-pass ms |\n";
   md += "|---|---|---|---|---|---|---|\n";

@@ -20,10 +20,12 @@ std::string RestirOptions::name() const {
   const std::string k = (prefix == RestirOptions{}.prefix ? "" : strf(" K%d", prefix)) +
                         (lightCandidates == RestirOptions{}.lightCandidates ? "" : strf(" L%d", lightCandidates)) +
                         (historyCapMoving == RestirOptions{}.historyCapMoving ? "" : strf(" cm%d", historyCapMoving)) +
+                        (historyCapStatic == RestirOptions{}.historyCapStatic ? "" : strf(" cs%d", historyCapStatic)) +
                         (candidatesMoving == RestirOptions{}.candidatesMoving ? "" : strf(" Mm%d", candidatesMoving)) +
+                        (roundsStatic == RestirOptions{}.roundsStatic ? "" : strf(" Rs%d", roundsStatic)) +
                         (reconnect ? "" : " copy") +
                         (fixedNeighbourX || fixedNeighbourY ? strf(" at(%d,%d)", fixedNeighbourX, fixedNeighbourY) : "");
-  if (rounds == 0) return strf("restir %s M%d R0 c%d%s", kind, candidates, historyCap, k.c_str());
+  if (rounds == 0 && roundsStatic <= 0) return strf("restir %s M%d R0 c%d%s", kind, candidates, historyCap, k.c_str());
   return strf("restir %s M%d k%d r%d R%d c%d%s", kind, candidates, neighbours, radius, rounds, historyCap, k.c_str());
 }
 
@@ -34,8 +36,10 @@ RestirOptions restirOptionsOf(const RenderSettings& rs) {
   o.neighbours = rs.restirNeighbours;
   o.radius = rs.restirRadius;
   o.rounds = rs.restirRounds;
+  o.roundsStatic = rs.restirRoundsStatic;
   o.historyCap = rs.restirHistoryCap;
   o.historyCapMoving = rs.restirHistoryCapMoving;
+  o.historyCapStatic = rs.restirHistoryCapStatic;
   o.mis = rs.restirMis == "gbh" ? shared::RS_MIS_GBH : shared::RS_MIS_PAIRWISE;
   o.prefix = rs.restirPrefix;
   o.lightCandidates = rs.restirLightCandidates;
@@ -331,19 +335,28 @@ void Restir::fillFrame(int frame, uint32_t sequence, uint32_t key) {
   frame_ = gpuFrame(scene_, frame, uint32_t(scene_.render.seed) + 0x9E3779B9u * sequence, key);
   const shared::GpuCamera& cam = frame_.camera;
   const bool still = sameCamera(prevCam_, cam);
-  // The cap depends on the cameras only, never on a sample, so either value keeps reuse unbiased.
-  const int cap = still ? options_.historyCap : std::min(options_.historyCap, options_.historyCapMoving);
+  // The history's domain is the current one (a still camera over the grid it was rendered with):
+  // the temporal shift is the identity and both cross-domain targets are the stored ones.
+  const bool sameVolume = previousSerial_ == currentSerial_ && renderedSerial_ == currentSerial_;
+  // The cap depends on the cameras and grids only, never on a sample, so any value keeps reuse
+  // unbiased. Where nothing changed (the same domain) the static cap, if set and temporal reuse is on.
+  int cap = options_.historyCap;
+  if (!still) {
+    cap = std::min(cap, options_.historyCapMoving);
+  } else if (sameVolume && cap > 0 && options_.historyCapStatic > 0) {
+    cap = options_.historyCapStatic;
+  }
   params_.historyCap = float(cap);
   // Likewise the candidates (a per-frame M is a constant of the canonical reservoir), in frames
   // whose camera moved since the previous frame of the sequence (the first frame keeps M).
   const bool moved = hasHistory_ && prevSequence_ == sequence && !still;
   params_.candidates = uint32_t(moved && options_.candidatesMoving > 0 ? options_.candidatesMoving : options_.candidates);
+  // And the spatial rounds where nothing changed (a per-frame constant too: which neighbours a
+  // pixel reuses never depends on a sample).
+  rounds_ = still && sameVolume && options_.roundsStatic >= 0 ? options_.roundsStatic : options_.rounds;
   const bool history = hasHistory_ && cap > 0 && prevSequence_ == sequence;
   if (history) params_.prevCamera = prevCam_;
   params_.historyValid = history ? 1u : 0u;
-  // The history's domain is the current one (a still camera over the grid it was rendered with):
-  // the temporal shift is the identity and both cross-domain targets are the stored ones.
-  const bool sameVolume = previousSerial_ == currentSerial_ && renderedSerial_ == currentSerial_;
   params_.historySameDomain = history && still && sameVolume ? 1u : 0u;
   // The lamps seen directly (restir/candidates.glsl rs_lamp_reservoir): the sets alternate; the
   // history is the same pixel's only with a still camera.
@@ -459,7 +472,7 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
       gpu::computeBarrier(cmd);
       cur = out;
     }
-    for (int r = 0; r < options_.rounds; ++r) {
+    for (int r = 0; r < rounds_; ++r) {
       const uint32_t out = (cur + 1) % kSets;
       push.inSet = cur;
       push.historySet = cur;

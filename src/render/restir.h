@@ -35,8 +35,10 @@ struct RestirOptions {
   int neighbours = 2;        // k (as render.restir_neighbours)
   int radius = 16;           // px
   int rounds = 1;            // R (0: no spatial reuse)
+  int roundsStatic = -1;     // R where camera and grid are both still (-1: rounds)
   int historyCap = 20;       // c (0: no temporal reuse)
   int historyCapMoving = 8;  // c while the camera moves (at most historyCap)
+  int historyCapStatic = 0;  // c where camera and grid are both still (0: historyCap)
   uint32_t mis = shared::RS_MIS_PAIRWISE;
   int prefix = 16;           // K: vertices a reservoir's path holds (<= RS_MAX_VERTICES); the paths
                              // of more vertices are path traced in final shading (notes/restir.md)
@@ -156,6 +158,7 @@ class Restir {
   // The frame's pixels, those that may see the volume first (render/pixel_order.h), and the
   // camera and volume they were found for (recomputed and uploaded when either changes).
   PixelOrder pixelOrder_;
+  int rounds_ = 1;  // this frame's spatial rounds (options_.rounds, or roundsStatic where nothing changed)
   uint32_t lampPixels_ = 0;  // the lamp pass's list (after the order and the mask in paramBuffer_)
   shared::GpuCamera orderCam_{};
   uint64_t orderSerial_ = 0;

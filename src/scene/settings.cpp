@@ -37,6 +37,11 @@ const std::vector<SettingDesc>& renderSettingsTable() {
       {"restir_neighbours", "ReSTIR: spatial neighbours k per round", &RenderSettings::restirNeighbours, 1, 8, {}},
       {"restir_radius", "ReSTIR: spatial neighbour radius in pixels", &RenderSettings::restirRadius, 1, 256, {}},
       {"restir_rounds", "ReSTIR: spatial reuse rounds R (0 = no spatial reuse)", &RenderSettings::restirRounds, 0, 8, {}},
+      {"restir_rounds_static",
+       "ReSTIR: spatial reuse rounds in frames where neither the camera nor the grid changed since the previous "
+       "frame (-1 = restir_rounds): 0 with a long restir_history_cap_static (which see), spatial reuse staying "
+       "in the frames whose history a shift thins out",
+       &RenderSettings::restirRoundsStatic, -1, 8, {}},
       {"restir_history_cap", "ReSTIR: temporal confidence cap c, M_hist <= c * M_cur (0 = no temporal reuse)",
        &RenderSettings::restirHistoryCap, 0, 1000, {}},
       {"restir_history_cap_moving",
@@ -47,6 +52,20 @@ const std::vector<SettingDesc>& renderSettingsTable() {
        "most into lasting fireflies. 8 measured best over smoke (notes/restir.md \"Session 29\"); where many "
        "shifts fail (surfaces, small lamps) a shorter one is (the bundled city sets 5)",
        &RenderSettings::restirHistoryCapMoving, 0, 1000, {}},
+      {"restir_history_cap_static",
+       "ReSTIR: the temporal confidence cap in frames where neither the camera nor the grid changed since the "
+       "previous frame (a paused viewer, a still shot of one grid frame; 0 = restir_history_cap; none with "
+       "restir_history_cap 0, which turns temporal reuse off). The history's "
+       "path then lands where it was and both targets are one function, so the history is the pixel's own "
+       "earlier candidates and no sample's weight grows under the shift: the longer the cap, the more of them "
+       "a still view keeps resampling. With spatial reuse in those frames (restir_rounds_static) a long history "
+       "grows fireflies instead: neighbours' histories reach a pixel shifted, and the samples a shift brightens "
+       "weigh up to the cap times their due; hence restir_rounds_static 0 with it. For frames shown one at a "
+       "time, each from its own history (the bench's metric; the bundled city with 400: 45-54x lower relMSE "
+       "than the path tracer at equal time per frame, 12-14x with its own settings): where frames are averaged "
+       "(plume render's iterations, the viewer's accumulation) their correlation costs more than the cap gains, "
+       "so no bundled scene sets it (notes/city.md \"Session 32\")",
+       &RenderSettings::restirHistoryCapStatic, 0, 100000, {}},
       {"restir_mis", "ReSTIR: MIS weights for reuse: pairwise (O(k)) or gbh (generalised balance heuristic, O(k^2))",
        &RenderSettings::restirMis, 0, 0, {"pairwise", "gbh"}},
       {"restir_light_candidates",

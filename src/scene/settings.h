@@ -32,8 +32,10 @@ struct RenderSettings {
                                      // everywhere measured: notes/restir.md "Session 24")
   int restirRadius = 16;             // spatial neighbour radius, pixels
   int restirRounds = 1;              // R: spatial rounds (0 = no spatial reuse)
+  int restirRoundsStatic = -1;       // ... where camera and grid are both still (-1: restirRounds)
   int restirHistoryCap = 20;         // temporal confidence cap c: M_hist <= c * M_cur (0 = no temporal)
   int restirHistoryCapMoving = 8;    // ... while the camera moves (at most restirHistoryCap)
+  int restirHistoryCapStatic = 0;    // ... where camera and grid are both still (0: restirHistoryCap)
   std::string restirMis = "pairwise";  // pairwise | gbh (generalised balance heuristic)
   int restirPrefix = 16;             // path vertices a reservoir holds; longer paths: a path-traced tail
   int restirLightCandidates = 2;     // light samples resampled at each candidate vertex (RIS)

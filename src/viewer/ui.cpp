@@ -7,6 +7,9 @@
 #include <imgui.h>
 
 #include <cmath>
+#include <initializer_list>
+#include <map>
+#include <string>
 
 namespace plume::viewer {
 namespace {
@@ -60,16 +63,25 @@ int intSetting(const RenderSettings& rs, const SettingDesc& d) {
   return 0;
 }
 
-// On/off switch for a count setting where 0 means off (temporal reuse = history cap, spatial
-// reuse = rounds); switching on restores the last non-zero value.
-void drawReuseToggle(ViewState& s, UiRequests& req, const char* label, const char* key, int& remembered) {
-  const SettingDesc* d = findSetting(key);
-  if (!d) return;
-  const int value = intSetting(s.scene.render, *d);
-  if (value > 0) remembered = value;
-  bool on = value > 0;
+// On/off switch for count settings where 0 means off (temporal reuse = the history cap, spatial
+// reuse = the rounds and those where nothing changed): on while any of them is positive;
+// switching off sets those to 0, switching on restores the values they had when last on
+// (`remembered`, which holds a start value for the first key).
+void drawReuseToggle(ViewState& s, UiRequests& req, const char* label, std::initializer_list<const char*> keys,
+                     std::map<std::string, int>& remembered) {
+  bool on = false;
+  for (const char* key : keys) {
+    const SettingDesc* d = findSetting(key);
+    const int value = d ? intSetting(s.scene.render, *d) : 0;
+    if (value > 0) remembered[key] = value, on = true;
+  }
   if (ImGui::Checkbox(label, &on)) {
-    applyRenderSettingText(s.scene.render, key, std::to_string(on ? std::max(1, remembered) : 0));
+    for (const char* key : keys) {
+      const SettingDesc* d = findSetting(key);
+      if (!d) continue;
+      if (!on && intSetting(s.scene.render, *d) > 0) applyRenderSettingText(s.scene.render, key, "0");
+      if (on && remembered.count(key)) applyRenderSettingText(s.scene.render, key, std::to_string(remembered[key]));
+    }
     req.rebuildRenderer = true;
   }
 }
@@ -110,11 +122,11 @@ void drawSetting(ViewState& s, UiRequests& req, const SettingDesc& d) {
 void drawSettingsTable(ViewState& s, UiRequests& req, const ViewStats& stats) {
   auto used = [&](const std::string& key) { return !stats.usesSetting || stats.usesSetting(key); };
   const bool restirOn = used("restir_history_cap");
-  static int historyCap = 20, rounds = 1;
+  static std::map<std::string, int> remembered = {{"restir_history_cap", 20}, {"restir_rounds", 1}};
   ImGui::BeginDisabled(!restirOn);
-  drawReuseToggle(s, req, "temporal reuse", "restir_history_cap", historyCap);
+  drawReuseToggle(s, req, "temporal reuse", {"restir_history_cap"}, remembered);
   ImGui::SameLine();
-  drawReuseToggle(s, req, "spatial reuse", "restir_rounds", rounds);
+  drawReuseToggle(s, req, "spatial reuse", {"restir_rounds", "restir_rounds_static"}, remembered);
   ImGui::EndDisabled();
   if (!restirOn) ImGui::TextDisabled("restir_* settings act in the ReSTIR modes");
   for (const SettingDesc& d : renderSettingsTable()) {
