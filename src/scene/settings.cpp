@@ -61,7 +61,7 @@ const std::vector<SettingDesc>& renderSettingsTable() {
        "a still view keeps resampling. With spatial reuse in those frames (restir_rounds_static) a long history "
        "grows fireflies instead: neighbours' histories reach a pixel shifted, and the samples a shift brightens "
        "weigh up to the cap times their due; hence restir_rounds_static 0 with it. For frames shown one at a "
-       "time, each from its own history (the bench's metric; the bundled city with 400: 45-54x lower relMSE "
+       "time, each from its own history (the bench's metric; the bundled city with 400: 39-54x lower relMSE "
        "than the path tracer at equal time per frame, 12-14x with its own settings): where frames are averaged "
        "(plume render's iterations, the viewer's accumulation) their correlation costs more than the cap gains, "
        "so no bundled scene sets it (notes/city.md \"Session 32\")",
