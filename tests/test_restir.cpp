@@ -27,6 +27,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <initializer_list>
+#include <memory>
 #include <random>
 #include <stdexcept>
 
@@ -180,6 +182,18 @@ std::vector<Image> restirFrames(gpu::Context& ctx, gpu::ShaderCompiler& compiler
   return out;
 }
 
+// The baked grids of noise clouds of the given seeds, one per frame (restirFrames: one grid held
+// still, four animated).
+std::vector<std::unique_ptr<GpuVolumeResources>> noiseVolumes(gpu::Context& ctx, const Scene& s,
+                                                              std::initializer_list<unsigned> seeds) {
+  std::vector<std::unique_ptr<GpuVolumeResources>> volumes;
+  for (unsigned seed : seeds) {
+    volumes.push_back(std::make_unique<GpuVolumeResources>(ctx, *bakeOf(test::makeNoiseGrid(40, 1.0 / 20, seed)),
+                                                           s.media[0].densityScale));
+  }
+  return volumes;
+}
+
 // Channels of two runs' frames whose bits differ, and channels lit in the first run.
 struct BitDifferences {
   size_t differ = 0, lit = 0;
@@ -247,15 +261,21 @@ TEST_F(GpuRestir, SpatialReuseGbhMatchesReference) {
   expectMatches(run, reference(s, grid, 512), "spatial_gbh");
 }
 
-TEST_F(GpuRestir, TemporalAndSpatialStillCameraMatchesReference) {
-  Scene s = baseScene(16);
+// ReSTIR over `frames` frames of a still camera over a still noise cloud, against the reference.
+void expectStillCameraMatches(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const RestirOptions& o, int frames,
+                              const char* label) {
+  const Scene s = baseScene(16);
   auto grid = test::makeNoiseGrid(40, 1.0 / 20, 2);
+  RunSpec spec;
+  spec.framesPerRun = frames;
+  RestirRun run = runRestir(ctx, compiler, s, o, spec, [&](int) { return grid; });
+  expectMatches(run, reference(s, grid, 512), label);
+}
+
+TEST_F(GpuRestir, TemporalAndSpatialStillCameraMatchesReference) {
   RestirOptions o;  // defaults: temporal (c = 20) + one spatial round, pairwise
   o.radius = 6;
-  RunSpec spec;
-  spec.framesPerRun = 4;
-  RestirRun run = runRestir(ctx(), compiler(), s, o, spec, [&](int) { return grid; });
-  expectMatches(run, reference(s, grid, 512), "temporal_still");
+  expectStillCameraMatches(ctx(), compiler(), o, 4, "temporal_still");
 }
 
 // The same with render.density_filter = exact (8 texel reads with exact weights): the default,
@@ -561,12 +581,8 @@ TEST_F(GpuRestir, StaticHistoryCapActsOnlyWhereNothingChanged) {
   RestirOptions longer = capped;
   longer.historyCapStatic = 8;
   const DifferingPixels d = differingPixels(ctx(), compiler(), longer, capped);
-  Scene s = baseScene(16);
-  std::vector<std::unique_ptr<GpuVolumeResources>> animated;
-  for (int f = 1; f <= 4; ++f) {
-    animated.push_back(std::make_unique<GpuVolumeResources>(
-        ctx(), *bakeOf(test::makeNoiseGrid(40, 1.0 / 20, unsigned(10 + f))), s.media[0].densityScale));
-  }
+  const Scene s = baseScene(16);
+  const auto animated = noiseVolumes(ctx(), s, {11, 12, 13, 14});
   const auto [differAnimated, lit] = bitDifferences(restirFrames(ctx(), compiler(), s, longer, animated),
                                                     restirFrames(ctx(), compiler(), s, capped, animated));
   std::printf("[restir] restir_history_cap_static 8 against 0 (cap 1): %zu of %zu pixels differ still, %zu with the "
@@ -583,17 +599,12 @@ TEST_F(GpuRestir, StaticHistoryCapActsOnlyWhereNothingChanged) {
 // but at 64 x M here, 8 frames per run (the history holds up to 7 frames' candidates, past the
 // plain cap from the fourth frame on).
 TEST_F(GpuRestir, LongStaticHistoryMatchesReference) {
-  Scene s = baseScene(16);
-  auto grid = test::makeNoiseGrid(40, 1.0 / 20, 2);
   RestirOptions o;
   o.radius = 6;
   o.roundsStatic = 0;
   o.historyCap = 2;
   o.historyCapStatic = 64;
-  RunSpec spec;
-  spec.framesPerRun = 8;
-  RestirRun run = runRestir(ctx(), compiler(), s, o, spec, [&](int) { return grid; });
-  expectMatches(run, reference(s, grid, 512), "long_static_history");
+  expectStillCameraMatches(ctx(), compiler(), o, 8, "long_static_history");
 }
 
 // restir_rounds_static sets R only in frames where neither the camera nor the grid changed: over a
@@ -609,13 +620,7 @@ TEST_F(GpuRestir, StaticRoundsActOnlyWhereNothingChanged) {
     key.pose.position += glm::vec3(0.05f * float(f), 0.02f * float(f), 0.0f);
     moving.camera.keys.push_back(key);
   }
-  std::vector<std::unique_ptr<GpuVolumeResources>> one, animated;
-  one.push_back(std::make_unique<GpuVolumeResources>(ctx(), *bakeOf(test::makeNoiseGrid(40, 1.0 / 20, 2)),
-                                                     s.media[0].densityScale));
-  for (int f = 1; f <= 4; ++f) {
-    animated.push_back(std::make_unique<GpuVolumeResources>(
-        ctx(), *bakeOf(test::makeNoiseGrid(40, 1.0 / 20, unsigned(10 + f))), s.media[0].densityScale));
-  }
+  const auto one = noiseVolumes(ctx(), s, {2}), animated = noiseVolumes(ctx(), s, {11, 12, 13, 14});
   RestirOptions set;
   set.radius = 6;
   set.roundsStatic = 0;  // R 1 elsewhere
