@@ -39,8 +39,8 @@ const std::vector<SettingDesc>& renderSettingsTable() {
       {"restir_rounds", "ReSTIR: spatial reuse rounds R (0 = no spatial reuse)", &RenderSettings::restirRounds, 0, 8, {}},
       {"restir_rounds_static",
        "ReSTIR: spatial reuse rounds in frames where neither the camera nor the grid changed since the previous "
-       "frame (-1 = restir_rounds): 0 with a long restir_history_cap_static (which see), spatial reuse staying "
-       "in the frames whose history a shift thins out",
+       "frame (-1 = restir_rounds): 0 goes with a long restir_history_cap_static (see there), spatial reuse "
+       "staying in the frames whose history a shift thins out",
        &RenderSettings::restirRoundsStatic, -1, 8, {}},
       {"restir_history_cap", "ReSTIR: temporal confidence cap c, M_hist <= c * M_cur (0 = no temporal reuse)",
        &RenderSettings::restirHistoryCap, 0, 1000, {}},
