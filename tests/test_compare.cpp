@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 using namespace plume;
@@ -71,6 +72,23 @@ TEST_F(Compare, PassesForTwoEstimatesOfTheSameImage) {
   for (const char* s : {"relMSE", "mean ratio", "failing", "worst pixel", "pass"}) {
     EXPECT_NE(r.output.find(s), std::string::npos) << s << "\n" << r.output;
   }
+}
+
+TEST_F(Compare, WorstListsWhereTheErrorSits) {
+  // The biased image's error is in its top-left quarter: every listed pixel lies there.
+  test::RunResult r = test::runPlume({"compare", path("biased.exr"), path("b.exr"), "--worst", "5"});
+  EXPECT_EQ(r.exitCode, 1) << r.output;
+  EXPECT_NE(r.output.find("worst 1% of pixels hold"), std::string::npos) << r.output;
+  int listed = 0;
+  for (size_t at = r.output.find("\n  ("); at != std::string::npos; at = r.output.find("\n  (", at + 1)) {
+    int x = -1, y = -1;
+    ASSERT_EQ(std::sscanf(r.output.c_str() + at, "\n  (%d, %d)", &x, &y), 2) << r.output;
+    EXPECT_LT(x, 16) << r.output;
+    EXPECT_LT(y, 12) << r.output;
+    ++listed;
+  }
+  EXPECT_EQ(listed, 5) << r.output;
+  EXPECT_EQ(test::runPlume({"compare", path("a.exr"), path("b.exr"), "--worst", "-1"}).exitCode, 2);
 }
 
 TEST_F(Compare, FailsForABiasedImage) {

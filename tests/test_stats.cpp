@@ -178,6 +178,29 @@ TEST(Stats, RelMse) {
   EXPECT_EQ(meanRatio(std::vector<float>{0, 0}, std::vector<float>{0, 0}), 1.0);
 }
 
+TEST(Stats, WorstPixelsAndTheirShares) {
+  Image ref = noisyImage(8, 4, 6), x = ref;
+  EXPECT_EQ(shareOfWorst(x, ref, 0.01), 0.0);  // no error at all
+  // Errors in two pixels only: (5, 2) three times the squared error of (1, 0), in one channel each.
+  const auto at = [&](int px, int py, int c) { return size_t(3 * (py * 8 + px) + c); };
+  const double r0 = ref.rgb[at(1, 0, 1)], r1 = ref.rgb[at(5, 2, 2)];
+  x.rgb[at(1, 0, 1)] += float(0.1 * std::sqrt(r0 * r0 + 1e-2));
+  x.rgb[at(5, 2, 2)] += float(0.1 * std::sqrt(3.0) * std::sqrt(r1 * r1 + 1e-2));
+  const std::vector<PixelError> w = worstPixels(x, ref, 3);
+  ASSERT_EQ(w.size(), 3u);
+  EXPECT_EQ(w[0].x, 5);
+  EXPECT_EQ(w[0].y, 2);
+  EXPECT_NEAR(w[0].share, 0.75, 1e-4);
+  EXPECT_EQ(w[1].x, 1);
+  EXPECT_EQ(w[1].y, 0);
+  EXPECT_NEAR(w[1].share, 0.25, 1e-4);
+  EXPECT_EQ(w[2].share, 0.0);
+  EXPECT_NEAR(shareOfWorst(x, ref, 0.01), 0.75, 1e-4);  // 1% of 32 pixels: one pixel
+  EXPECT_NEAR(shareOfWorst(x, ref, 2.0 / 32.0), 1.0, 1e-9);
+  EXPECT_EQ(worstPixels(x, ref, 100).size(), 32u);
+  EXPECT_THROW(worstPixels(x, noisyImage(4, 4, 6), 1), InputError);
+}
+
 TEST(Stats, ZTestPassesIndependentEstimatesOfTheSameImage) {
   for (uint32_t seed = 0; seed < 4; ++seed) {
     const Image a = noisyImage(64, 64, 10 + seed), b = noisyImage(64, 64, 20 + seed);

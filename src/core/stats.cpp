@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <numeric>
 
@@ -169,6 +170,47 @@ void checkSameSize(const Image& a, const Image& b) {
 double relMse(const Image& x, const Image& reference) {
   checkSameSize(x, reference);
   return relMse(x.rgb, reference.rgb);
+}
+
+namespace {
+// Each pixel's relMSE terms summed over its channels, and their total.
+std::vector<double> pixelTerms(const Image& x, const Image& reference, double& total) {
+  checkSameSize(x, reference);
+  std::vector<double> terms(size_t(x.width) * size_t(x.height), 0.0);
+  total = 0.0;
+  for (size_t i = 0; i < x.rgb.size(); ++i) {
+    const double d = double(x.rgb[i]) - reference.rgb[i], r = reference.rgb[i];
+    const double t = d * d / (r * r + 1e-2);
+    terms[i / 3] += t;
+    total += t;
+  }
+  return terms;
+}
+}  // namespace
+
+std::vector<PixelError> worstPixels(const Image& x, const Image& reference, int n) {
+  double total = 0.0;
+  const std::vector<double> terms = pixelTerms(x, reference, total);
+  std::vector<size_t> order(terms.size());
+  std::iota(order.begin(), order.end(), size_t(0));
+  const size_t k = std::min(order.size(), size_t(std::max(n, 0)));
+  std::partial_sort(order.begin(), order.begin() + ptrdiff_t(k), order.end(),
+                    [&](size_t a, size_t b) { return terms[a] > terms[b] || (terms[a] == terms[b] && a < b); });
+  std::vector<PixelError> out;
+  for (size_t j = 0; j < k; ++j) {
+    const size_t p = order[j];
+    out.push_back({int(p % size_t(x.width)), int(p / size_t(x.width)), total > 0.0 ? terms[p] / total : 0.0});
+  }
+  return out;
+}
+
+double shareOfWorst(const Image& x, const Image& reference, double fraction) {
+  double total = 0.0;
+  std::vector<double> terms = pixelTerms(x, reference, total);
+  if (terms.empty() || total <= 0.0) return 0.0;
+  const size_t k = std::clamp(size_t(std::ceil(fraction * double(terms.size()))), size_t(1), terms.size());
+  std::nth_element(terms.begin(), terms.begin() + ptrdiff_t(k - 1), terms.end(), std::greater<double>());
+  return std::accumulate(terms.begin(), terms.begin() + ptrdiff_t(k), 0.0) / total;
 }
 
 double meanRatio(std::span<const float> a, std::span<const float> b) {

@@ -59,6 +59,15 @@ double sidakLevel(double alpha, double count);
 // mean over pixels and channels of (x - r)^2 / (r^2 + 1e-2); x, r: equal-length rgb arrays.
 double relMse(std::span<const float> x, std::span<const float> reference);
 double relMse(const Image& x, const Image& reference);  // throws InputError on a size mismatch
+// Where relMSE sits: each pixel's share of it (the sum of its three channels' terms over the
+// image's sum), the n largest, largest first. Throws InputError on a size mismatch.
+struct PixelError {
+  int x = 0, y = 0;
+  double share = 0.0;  // of the image's relMSE, in [0, 1]
+};
+std::vector<PixelError> worstPixels(const Image& x, const Image& reference, int n);
+// The share of relMSE held by the largest `fraction` of the pixels (at least one pixel).
+double shareOfWorst(const Image& x, const Image& reference, double fraction);
 // mean(a) / mean(b) over all pixels and channels: 1 when both means are 0, inf or NaN when
 // only mean(b) is 0.
 double meanRatio(std::span<const float> a, std::span<const float> b);
