@@ -276,19 +276,28 @@ TEST_F(CityGpuTest, RestirMatchesReferenceOnTheBundledCity) {
   test::expectRestirMatchesReference(ctx(), compiler(), s, grid.grid, 1024, 16384, "city", {shared::RS_MIS_PAIRWISE});
 }
 
+namespace {
+// The whole city at 40 x 40, 2 bounces (the lamp pass's tests).
+Scene smallCity() {
+  Scene s = loadScene(test::sourcePath("volumes/city/city.json"));
+  s.camera.width = s.camera.height = 40;
+  s.render.maxBounces = 2;
+  return s;
+}
+}  // namespace
+
 // ReSTIR's lamps seen directly are traced only in the pixels whose camera rays may meet an
 // emitter's front (render/pixel_order.h emitterPixelMask, a pass of their own over them); every
 // other pixel's lamp reservoir would be empty, so the frames equal those of every pixel tracing
-// its 16 rays over the whole pixel (RestirOptions::lampRects off in both: the rectangles draw other
-// rays, tested by PixelOrder.EveryPixelThatSeesAnEmittersFrontIsMarked and the lamps' Z-tests,
+// its 16 rays over the whole pixel (RestirOptions::lampTriangles and lampRects off in both: the
+// pieces and the rectangles draw other rays, tested by PixelOrder.EveryRayThatMeetsAnEmittersFront-
+// LiesOnOneOfItsPieces, PixelOrder.EveryPixelThatSeesAnEmittersFrontIsMarked and the lamps' Z-tests,
 // test_restir_surfaces.cpp), bit for bit: the whole city at 40 x 40 (8000 emitters, some under a pixel wide),
 // four frames with a still camera (the lamp reservoirs' history merged) and four moving (309 and
 // 340 of 1600 pixels traced). Can it fail: with the mask's triangles shrunk to their centroids and
 // no margin (a sabotage of emitterPixelMask: 262 and 268 pixels) 33 and 27 channels differ.
 TEST_F(CityGpuTest, LampPassGivesTheFramesOfEveryPixelTracingItsLamps) {
-  Scene s = loadScene(test::sourcePath("volumes/city/city.json"));
-  s.camera.width = s.camera.height = 40;
-  s.render.maxBounces = 2;
+  Scene s = smallCity();
   const LoadedGrid grid = cityGrid(s);
   const GpuVolumeResources volume(ctx(), bakeVolume(grid), s.medium().densityScale);
   Scene moving = s;
@@ -302,6 +311,7 @@ TEST_F(CityGpuTest, LampPassGivesTheFramesOfEveryPixelTracingItsLamps) {
     auto frames = [&](bool cull, uint32_t& lampPixels) {
       RestirOptions o;
       o.cullLampPixels = cull;
+      o.lampTriangles = false;
       o.lampRects = false;
       Restir restir(ctx(), compiler(), *scene, o);
       restir.setVolumes(volume, volume);
@@ -327,6 +337,56 @@ TEST_F(CityGpuTest, LampPassGivesTheFramesOfEveryPixelTracingItsLamps) {
     EXPECT_EQ(differ, 0u) << name << ": the lamp pass must not change any pixel";
     EXPECT_GT(lit, culled.size() * culled[0].rgb.size() / 4) << name << ": too few lit channels";
   }
+}
+
+// The pieces of emitter projections that ReSTIR's lamp reservoirs draw their rays on (RestirOptions::
+// lampTriangles, render/pixel_order.h emitterPixelTriangles) sit in the parameter buffer, which
+// must fit the device's largest storage buffer (lavapipe: 128 MiB, a 1080p frame filled by an
+// emitter would pass it); past that the pixels with the most pieces draw in their rectangles in a
+// pass of their own (Restir::lampRectPixels, logged). With room for no piece every pixel does, and
+// the frames are those of the rectangles asked for (lampTriangles off), bit for bit; with room for
+// some, some do. The city at 40 x 40, frames 1-2 of a still camera.
+TEST_F(CityGpuTest, LampPiecesPastTheBufferLimitDrawInTheirRectangles) {
+  const Scene s = smallCity();
+  const LoadedGrid grid = cityGrid(s);
+  const GpuVolumeResources volume(ctx(), bakeVolume(grid), s.medium().densityScale);
+  struct Run {
+    std::vector<Image> frames;
+    uint32_t lampPixels = 0, rectPixels = 0;
+  };
+  auto run = [&](bool pieces, size_t words) {
+    RestirOptions o;
+    o.lampTriangles = pieces;
+    o.lampPieceWords = words;
+    Restir restir(ctx(), compiler(), s, o);
+    restir.setVolumes(volume, volume);
+    Run r;
+    for (int f = 1; f <= 2; ++f) r.frames.push_back(restir.renderFrame(f, 1));
+    r.lampPixels = restir.lampPixels();
+    r.rectPixels = restir.lampRectPixels();
+    return r;
+  };
+  auto differ = [](const Run& a, const Run& b) {
+    size_t n = 0;
+    for (size_t f = 0; f < a.frames.size(); ++f)
+      for (size_t i = 0; i < a.frames[f].rgb.size(); ++i)
+        n += std::memcmp(&a.frames[f].rgb[i], &b.frames[f].rgb[i], sizeof(float)) != 0 ? 1 : 0;
+    return n;
+  };
+  const Run rects = run(false, 0), none = run(true, 1), some = run(true, 8 * 200), all = run(true, 0);
+  std::printf("[city] lamp pieces: %u pixels may see an emitter; in rectangles: %u with room for no piece, %u with "
+              "room for 200, %u with the device's; channels that differ from the rectangles' frames: %zu, %zu, %zu\n",
+              all.lampPixels, none.rectPixels, some.rectPixels, all.rectPixels, differ(none, rects), differ(some, rects),
+              differ(all, rects));
+  EXPECT_EQ(rects.rectPixels, 0u) << "no pieces asked for, none refused";
+  EXPECT_EQ(none.rectPixels, none.lampPixels);
+  EXPECT_EQ(differ(none, rects), 0u) << "with no room for a piece the frames must be the rectangles'";
+  EXPECT_GT(some.rectPixels, 0u);
+  EXPECT_LT(some.rectPixels, some.lampPixels);
+  EXPECT_GT(differ(some, rects), 0u);
+  EXPECT_GT(differ(some, all), 0u);
+  EXPECT_EQ(all.rectPixels, 0u) << "the city's pieces fit the device";
+  EXPECT_GT(differ(all, rects), 0u);
 }
 
 // The bundled city on the device: 11922 triangles (the ground's 2, 392 boxes of 5 quads, 4000

@@ -249,6 +249,31 @@ struct UnpackedRect {
         u1(double(r >> 32 & 0xffffu) / 65535.0), v1(double(r >> 48) / 65535.0) {}
 };
 
+// A random camera (16-55 x 12-51 pixels, 25-65 degrees) and 12 triangles of every size (from a
+// few hundredths of a pixel to larger than the image), facing any way: 9 centred in front of the
+// camera, 3 around or behind it (some across its plane).
+struct EmitterTrial {
+  int width = 0, height = 0;
+  shared::GpuCamera cam{};
+  std::vector<glm::vec3> vertices;
+};
+EmitterTrial randomEmitterTrial(std::mt19937& rng) {
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  EmitterTrial t;
+  t.width = 16 + int(rng() % 40), t.height = 12 + int(rng() % 40);
+  const glm::vec3 position(4.0f * u(rng), 4.0f * u(rng), 4.0f * u(rng));
+  const glm::vec3 lookAt = position + glm::normalize(glm::vec3(u(rng), u(rng), u(rng)) + glm::vec3(0.0f, 0.0f, 1e-3f));
+  t.cam = cameraAt(position, lookAt, 25.0f + 20.0f * (u(rng) + 1.0f), t.width, t.height);
+  for (int k = 0; k < 12; ++k) {
+    // Centres in front (most), around or behind the camera; sizes from 1e-3 to 3 units.
+    const float ahead = k < 9 ? 1.0f + 5.0f * (u(rng) + 1.0f) : 2.0f * u(rng);
+    const glm::vec3 centre = position + ahead * t.cam.forward + 2.0f * glm::vec3(u(rng), u(rng), u(rng));
+    const float size = std::pow(10.0f, -3.0f + 1.75f * (u(rng) + 1.0f));
+    for (int c = 0; c < 3; ++c) t.vertices.push_back(centre + size * glm::vec3(u(rng), u(rng), u(rng)));
+  }
+  return t;
+}
+
 // render/pixel_order.h emitterPixelRects and its mask: every pixel one of whose camera rays meets
 // an emitter's front is marked (ReSTIR traces the lamps seen directly in those pixels only, so a
 // pixel left out wrongly would lose its lamp), and every such ray's (u, v) lies in its pixel's
@@ -258,22 +283,13 @@ struct UnpackedRect {
 // pixel (its corners, centre and random points) in double precision.
 TEST(PixelOrder, EveryPixelThatSeesAnEmittersFrontIsMarked) {
   std::mt19937 rng(777);
-  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
   size_t missed = 0, hits = 0, marks = 0, pixels = 0, rays = 0, outsideRect = 0;
   double rectArea = 0.0;
   for (int trial = 0; trial < 40; ++trial) {
-    const int width = 16 + int(rng() % 40), height = 12 + int(rng() % 40);
-    const glm::vec3 position(4.0f * u(rng), 4.0f * u(rng), 4.0f * u(rng));
-    const glm::vec3 lookAt = position + glm::normalize(glm::vec3(u(rng), u(rng), u(rng)) + glm::vec3(0.0f, 0.0f, 1e-3f));
-    const shared::GpuCamera cam = cameraAt(position, lookAt, 25.0f + 20.0f * (u(rng) + 1.0f), width, height);
-    std::vector<glm::vec3> vertices;
-    for (int k = 0; k < 12; ++k) {
-      // Centres in front (most), around or behind the camera; sizes from 1e-3 to 3 units.
-      const float ahead = k < 9 ? 1.0f + 5.0f * (u(rng) + 1.0f) : 2.0f * u(rng);
-      const glm::vec3 centre = position + ahead * cam.forward + 2.0f * glm::vec3(u(rng), u(rng), u(rng));
-      const float size = std::pow(10.0f, -3.0f + 1.75f * (u(rng) + 1.0f));
-      for (int c = 0; c < 3; ++c) vertices.push_back(centre + size * glm::vec3(u(rng), u(rng), u(rng)));
-    }
+    const EmitterTrial t = randomEmitterTrial(rng);
+    const int width = t.width, height = t.height;
+    const shared::GpuCamera& cam = t.cam;
+    const std::vector<glm::vec3>& vertices = t.vertices;
     const std::vector<uint64_t> rects = emitterPixelRects(cam, width, height, vertices);
     ASSERT_EQ(rects.size(), size_t(width) * height);
     const std::vector<uint32_t> mask = emitterPixelMask(rects);
@@ -312,6 +328,103 @@ TEST(PixelOrder, EveryPixelThatSeesAnEmittersFrontIsMarked) {
   EXPECT_LT(rectArea, 0.95 * double(marks)) << "the rectangles must leave parts of the pixels out";
   EXPECT_GT(hits, pixels / 20) << "too few pixels see an emitter for the test to mean much";
   EXPECT_LT(marks, pixels * 3 / 4) << "the mask must leave pixels out";
+}
+
+// render/pixel_order.h emitterPixelTriangles: the pieces the lamp reservoir draws its rays on.
+// Every ray of a pixel that meets an emitter's front lies on a piece of that emitter in that pixel
+// (a point left out would lose its part of the lamp: the estimator's unbiasedness rests on it),
+// the pieces lie in the pixel's square and an emitter's pieces in one pixel cover at most the
+// square; and they are tight: the exact projection's area in the pixel plus the growth's margin.
+// Random cameras and triangles as above (sizes from a thousandth of a unit), 24 rays a pixel.
+TEST(PixelOrder, EveryRayThatMeetsAnEmittersFrontLiesOnOneOfItsPieces) {
+  std::mt19937 rng(778);
+  size_t rays = 0, outside = 0, badCorners = 0, tooLarge = 0, pieces = 0;
+  double pieceArea = 0.0, exactArea = 0.0;
+  auto inTriangle = [](glm::dvec2 p, glm::dvec2 a, glm::dvec2 b, glm::dvec2 c) {
+    auto side = [](glm::dvec2 o, glm::dvec2 d, glm::dvec2 q) { return (d.x - o.x) * (q.y - o.y) - (d.y - o.y) * (q.x - o.x); };
+    // (up to 1e-9 of a pixel: a pixel's corner may round to a hair outside its pieces, a set of
+    // measure 0 that no drawn (u, v) meets)
+    const double s0 = side(a, b, p), s1 = side(b, c, p), s2 = side(c, a, p), e = 1e-9;
+    return (s0 >= -e && s1 >= -e && s2 >= -e) || (s0 <= e && s1 <= e && s2 <= e);
+  };
+  for (int trial = 0; trial < 40; ++trial) {
+    const EmitterTrial t = randomEmitterTrial(rng);
+    const int width = t.width, height = t.height;
+    const shared::GpuCamera& cam = t.cam;
+    const std::vector<glm::vec3>& vertices = t.vertices;
+    const EmitterPixelLists lists = emitterPixelTriangles(cam, width, height, vertices);
+    ASSERT_EQ(lists.begin.size(), size_t(width) * height + 1);
+    std::vector<double> trianglePieces(vertices.size() / 3, 0.0);  // each triangle's pieces' area
+    ASSERT_EQ(lists.begin.back(), lists.pieces.size());
+    std::uniform_real_distribution<double> w(0.0, 1.0);
+    for (int y = 0; y < height; ++y) {
+      for (int x = 0; x < width; ++x) {
+        const size_t i = size_t(y) * width + x;
+        std::vector<double> area(vertices.size() / 3, 0.0);
+        for (uint32_t j = lists.begin[i]; j < lists.begin[i + 1]; ++j) {
+          const EmitterPiece& e = lists.pieces[j];
+          for (glm::vec2 c : {e.a, e.b, e.c}) badCorners += c.x >= 0.0f && c.x <= 1.0f && c.y >= 0.0f && c.y <= 1.0f ? 0 : 1;
+          area[e.triangle] += e.area;
+          trianglePieces[e.triangle] += e.area;
+          ++pieces;
+        }
+        for (double a : area) tooLarge += a <= 1.0 + 1e-5 ? 0 : 1;
+        for (int r = 0; r < 24; ++r) {
+          const double fx = r < 4 ? (r & 1) : r == 4 ? 0.5 : w(rng), fy = r < 4 ? (r >> 1) : r == 4 ? 0.5 : w(rng);
+          for (size_t k = 0; k < vertices.size(); k += 3) {
+            if (!rayMeetsFront(cam, width, height, x + fx, y + fy, glm::dvec3(vertices[k]), glm::dvec3(vertices[k + 1]),
+                               glm::dvec3(vertices[k + 2]))) {
+              continue;
+            }
+            ++rays;
+            bool on = false;
+            for (uint32_t j = lists.begin[i]; j < lists.begin[i + 1] && !on; ++j) {
+              const EmitterPiece& e = lists.pieces[j];
+              on = e.triangle == k / 3 && inTriangle({fx, fy}, glm::dvec2(e.a), glm::dvec2(e.b), glm::dvec2(e.c));
+            }
+            outside += on ? 0 : 1;
+            if (!on && outside < 6) {
+              std::printf("off: trial %d pixel (%d, %d) ray (%.6f, %.6f) triangle %zu:", trial, x, y, fx, fy, k / 3);
+              for (uint32_t j = lists.begin[i]; j < lists.begin[i + 1]; ++j) {
+                const EmitterPiece& e = lists.pieces[j];
+                if (e.triangle == k / 3) std::printf(" [(%.4f %.4f) (%.4f %.4f) (%.4f %.4f)]", e.a.x, e.a.y, e.b.x, e.b.y, e.c.x, e.c.y);
+              }
+              std::printf("\n");
+            }
+          }
+        }
+      }
+    }
+    // The exact projections' areas of the triangles wholly in front of the camera's plane (the
+    // others' pieces are whole pixels), against their pieces'.
+    const glm::dvec3 pos(cam.position);
+    for (size_t k = 0; k < vertices.size(); k += 3) {
+      std::vector<glm::dvec2> corners;
+      bool front = true;
+      for (size_t c = 0; c < 3; ++c) {
+        const glm::dvec3 d = glm::dvec3(vertices[k + c]) - pos;
+        const double z = glm::dot(d, glm::dvec3(cam.forward));
+        front = front && z > 1e-3;
+        corners.push_back({(glm::dot(d, glm::dvec3(cam.right)) / z / (cam.tanHalfFovY * cam.aspect) + 1.0) * 0.5 * width,
+                           (1.0 - glm::dot(d, glm::dvec3(cam.up)) / z / cam.tanHalfFovY) * 0.5 * height});
+      }
+      const glm::dvec3 n = glm::cross(glm::dvec3(vertices[k + 1] - vertices[k]), glm::dvec3(vertices[k + 2] - vertices[k]));
+      if (!front || glm::dot(n, pos - glm::dvec3(vertices[k])) <= 0.0) continue;
+      for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) exactArea += polygonAreaInPixel(corners, x, y);
+      pieceArea += trianglePieces[k / 3];
+    }
+  }
+  std::printf("[pixel order] emitter pieces: %zu pieces, %zu rays meet a front, %zu of them off their emitter's "
+              "pieces; the pieces of the triangles in front of the camera's plane cover %.4f square pixels, their exact projections %.4f\n",
+              pieces, rays, outside, pieceArea, exactArea);
+  EXPECT_EQ(outside, 0u) << "a ray that meets an emitter's front must lie on one of that emitter's pieces";
+  EXPECT_EQ(badCorners, 0u) << "the pieces must lie in the pixel's square";
+  EXPECT_EQ(tooLarge, 0u) << "an emitter's pieces in a pixel must cover at most the pixel";
+  EXPECT_GT(rays, 1000u) << "too few rays meet an emitter for the test to mean much";
+  // Tight: the pieces cover the projections and little more.
+  EXPECT_GE(pieceArea, exactArea);
+  EXPECT_LT(pieceArea, 1.1 * exactArea) << "the pieces must follow the projections, not their rectangles";
 }
 
 // What the mask leaves out: a triangle whose back faces the camera, one behind the camera's plane;

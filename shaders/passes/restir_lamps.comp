@@ -1,8 +1,9 @@
 // ReSTIR's lamps seen directly (restir/candidates.glsl rs_lamp_reservoir): the lamp reservoir of
 // every pixel in the list whose camera rays may meet an emitter's front (render/pixel_order.h
-// emitterPixelRects), dense, so that a subgroup's lanes all trace, its rays drawn in the part of
-// the pixel where they may; the candidates pass writes the others' empty reservoirs. Only for
-// scenes with emissive surfaces.
+// emitterPixelMask), dense, so that a subgroup's lanes all trace, its rays drawn on the projections
+// of the emitter triangles the pixel may see (PLUME_RS_LAMP_TRIANGLES: emitterPixelTriangles) or in
+// the rectangle of the pixel where they may be seen (emitterPixelRects); the candidates pass writes
+// the others' empty reservoirs. Only for scenes with emissive surfaces.
 #version 450
 #extension GL_GOOGLE_include_directive : require
 
@@ -18,8 +19,19 @@ void main() {
   uvec2 pixel;
   if (!rs_dispatch_pixel(pixel)) return;
   RngState rng = rng_init(pixel, frame.frameKey, RNG_STREAM_CANDIDATES, frame.seed);
+  RsDomain D = rs_current_domain(pixel);
+  uint uv;
+  vec3 dirY;
+  float tY;
+#ifdef PLUME_RS_LAMP_TRIANGLES
+  uint start, count;
+  rs_lamp_triangles(start, count);
+  RsReservoir r = rs_lamp_triangle_candidates(D, start, count, rng, uv, dirY, tY);
+#else
   vec2 lo, hi;
   rs_lamp_rect(lo, hi);
-  rs_lamp_reservoir(rs_current_domain(pixel), pixel.y * frame.size.x + pixel.x, lo, hi, rng);
+  RsReservoir r = rs_lamp_rect_candidates(D, lo, hi, rng, uv, dirY, tY);
+#endif
+  rs_lamp_reservoir(D, pixel.y * frame.size.x + pixel.x, r, uv, dirY, tY, rng);
   loop_guard_check(frame.loopProbe);
 }

@@ -76,6 +76,24 @@ void rs_lamp_rect(out vec2 lo, out vec2 hi) {
   hi = unpackUnorm2x16(rsPixels[i + 1u]);
 }
 
+// The lamp pass pixel's pieces of emitter projections (render/pixel_order.h emitterPixelTriangles;
+// with RestirOptions::lampTriangles, in place of the rectangle): count pieces of 8 words from
+// rsPixels[start] on: the emitter triangle's device index, the piece's weight (Le's luminance times
+// its area in square pixels: rs_lamp_weight) and its three corners in the pixel's (u, v).
+void rs_lamp_triangles(out uint start, out uint count) {
+  uint i = push.listBegin + push.listCount + 2u * gl_GlobalInvocationID.x;
+  start = rsPixels[i];
+  count = rsPixels[i + 1u];
+}
+float rs_lamp_weight(uint start, uint j) { return uintBitsToFloat(rsPixels[start + 8u * j + 1u]); }
+uint rs_lamp_piece(uint start, uint j, out vec2 a, out vec2 b, out vec2 c) {
+  uint i = start + 8u * j;
+  a = uintBitsToFloat(uvec2(rsPixels[i + 2u], rsPixels[i + 3u]));
+  b = uintBitsToFloat(uvec2(rsPixels[i + 4u], rsPixels[i + 5u]));
+  c = uintBitsToFloat(uvec2(rsPixels[i + 6u], rsPixels[i + 7u]));
+  return rsPixels[i];
+}
+
 // The pixel of this invocation of a dispatch over rsPixels[push.listBegin ..][.. push.listCount]
 // (one-dimensional workgroups); false past the list's end.
 bool rs_dispatch_pixel(out uvec2 pixel) {

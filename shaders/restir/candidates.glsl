@@ -87,20 +87,23 @@ float rs_lamp_target(RsDomain D, uint v, uint uv) {
   return ph > 0.0f ? ph * vol_mean_tr(v, D.origin, dir, t) : 0.0f;
 }
 
-// The frame's lamp reservoir of the pixel (set rsp.lampSet): RS_DIRECT_RAYS candidates, ray i
-// uniform on cell i of a RS_DIRECT_SIDE² grid of the rectangle [lo, hi] of the pixel outside
-// which no camera ray meets an emitter's front (rs_lamp_rect; p̂ is 0 outside it), density
-// RS_DIRECT_RAYS / A there (A its area; MIS weights "1 if (u, v) lies in cell i", a partition of
-// the rectangle), confidence 1 in all: a lamp a tenth of a pixel across gets all the rays, not
-// one in six. The candidates are resampled by Le alone, p̂' (u, v) (candidate i's weight
-// p̂'(u_i, v_i) A / RS_DIRECT_RAYS), so that W = w_sum / p̂'(Y) is an unbiased contribution weight of the selected
-// Y (GRIS: any target of the candidates' own resampling gives one); the reservoir's p̂ is the
-// target with the smoke's transmittance, evaluated once for Y, and the merge below and final
-// shading use that W with it. One mean-field walk a pixel instead of one per ray that meets a
-// lamp, masked per ray on a SIMD back end; the rays of one pixel see a lamp through nearly the
-// same smoke, so Le alone selects about as well (notes/city.md "Session 29"). With a still
-// camera the previous frame's reservoir at the same pixel (its confidence capped at c) is merged
-// in with the generalised balance heuristic between the two domains, m_s(y) = M_s p̂_s(y) /
+// The frame's lamp reservoir of the pixel (set rsp.lampSet): RS_DIRECT_RAYS candidates, confidence
+// 1 in all, resampled by Le alone, p̂'(u, v), so that W = w_sum / p̂'(Y) is an unbiased contribution
+// weight of the selected Y (GRIS: any target of the candidates' own resampling gives one); the
+// reservoir's p̂ is the target with the smoke's transmittance, evaluated once for Y, and the merge
+// below and final shading use that W with it. One mean-field walk a pixel instead of one per ray
+// that meets a lamp, masked per ray on a SIMD back end; the rays of one pixel see a lamp through
+// nearly the same smoke, so Le alone selects about as well (notes/city.md "Session 29"). The
+// candidates are drawn one of two ways:
+// - on the emitter triangles the pixel may see (PLUME_RS_LAMP_TRIANGLES, the default:
+//   rs_lamp_triangle_candidates), where no ray is spent on the part of the pixel they leave out
+//   and the lamp's coverage of the pixel is computed, not sampled;
+// - or ray i uniform on cell i of a RS_DIRECT_SIDE² grid of the rectangle [lo, hi] of the pixel
+//   outside which no camera ray meets an emitter's front (rs_lamp_rect; p̂ is 0 outside it),
+//   density RS_DIRECT_RAYS / A there (A its area; MIS weights "1 if (u, v) lies in cell i", a
+//   partition of the rectangle): a lamp a tenth of a pixel across gets all the rays, not one in six.
+// With a still camera the previous frame's reservoir at the same pixel (its confidence capped at c)
+// is merged in with the generalised balance heuristic between the two domains, m_s(y) = M_s p̂_s(y) /
 // Σ_j M_j p̂_j(y), p̂_s the target with the volume input s was rendered with (the shift is the
 // identity: the same (u, v) in the same camera); with a still grid both targets are one function
 // and m_s = M_s / ΣM. The canonical input covers every (u, v) a lamp is seen through, so the
@@ -110,15 +113,17 @@ float rs_lamp_target(RsDomain D, uint v, uint uv) {
 // (every candidate's weight would be 0) and the candidates pass writes them (rs_lamp_skipped).
 // Both draw from the start of the pixel's candidates stream, RS_LAMP_DRAWS numbers, and the
 // walks go on from there.
-const uint RS_LAMP_DRAWS = 2u * RS_DIRECT_RAYS;  // (u, v) and the selection, per ray; 2 more to merge
+const uint RS_LAMP_DRAWS = 4u * RS_DIRECT_RAYS;  // 4 per candidate (2 per ray in a rectangle); 2 more to merge
 
 uint rs_lamp_draws() { return RS_LAMP_DRAWS + (rsp.lampHistory != 0u ? 2u : 0u); }
 
-void rs_lamp_reservoir(RsDomain D, uint pixelIndex, vec2 lo, vec2 hi, inout RngState rng) {
+// The canonical candidates in the rectangle [lo, hi] of the pixel (2 draws a ray).
+RsReservoir rs_lamp_rect_candidates(RsDomain D, vec2 lo, vec2 hi, inout RngState rng, out uint uv, out vec3 dirY,
+                                    out float tY) {
   RsReservoir r = rs_empty();
-  uint uv = 0u;
-  vec3 dirY = vec3(0.0f);  // the selected ray's direction and hit distance
-  float tY = 0.0f;
+  uv = 0u;
+  dirY = vec3(0.0f);  // the selected ray's direction and hit distance
+  tY = 0.0f;
   vec2 extent = hi - lo;
   float cellWeight = extent.x * extent.y * (1.0f / float(RS_DIRECT_RAYS));  // 1 / the density on the cell
   for (uint i = 0u; i < RS_DIRECT_RAYS; ++i) {
@@ -132,6 +137,75 @@ void rs_lamp_reservoir(RsDomain D, uint pixelIndex, vec2 lo, vec2 hi, inout RngS
       tY = t;
     }
   }
+  return r;
+}
+
+#ifdef PLUME_RS_LAMP_TRIANGLES
+const uint RS_LAMP_RAYS = 8u;  // candidates on the pieces (at most RS_DIRECT_RAYS: RS_LAMP_DRAWS)
+
+// Le's luminance at the first surface along the ray of sub-pixel position uv where that is the
+// front of triangle `prim` (0 elsewhere), the ray's direction and the hit's distance.
+float rs_lamp_emitted_by(RsDomain D, uint uv, uint prim, out vec3 dir, out float t) {
+  dir = rs_domain_dir(D, rs_unpack_uv(uv));
+  BvhHit hit = bvh_closest(D.origin, dir, 0.0f, SURF_FAR);
+  t = hit.t;
+  return hit.prim == prim ? rs_luminance(surf_emitted(hit.prim, surf_normal(hit.prim), dir)) : 0.0f;
+}
+
+// The canonical candidates on the emitter triangles the pixel may see, 4 draws a candidate. The
+// host cut the pixel into pieces (render/pixel_order.h emitterPixelTriangles): for each emitter
+// triangle whose front a camera ray of the pixel may meet, the part of the pixel its projection
+// covers, grown by a margin far above rounding, as a fan of triangles. The samples are pairs
+// (j, x): piece j and a point x on it, with target p̂'(j, x) = Le where x's ray first meets the
+// front of j's emitter, 0 elsewhere; since a ray first meets one surface and the pieces of one
+// emitter do not overlap, the pairs where p̂' > 0 are the (u, v) where the lamps' target is (each
+// with its one piece), so a contribution weight for (j, x) is one for (u, v) = x, in the history's
+// merge and in final shading alike. Source: piece j with probability w_j / S (rs_lamp_weight: Le_j
+// times the piece's area A_j; S the list's sum), x uniform on it, so p(j, x) = w_j / (S A_j); the
+// RS_LAMP_RAYS candidates are stratified over the list's cumulative weights (candidate i's draw
+// in [i, i + 1) S / RS_LAMP_RAYS), so their densities sum to RS_LAMP_RAYS p, and with the
+// balance heuristic across them each weighs p̂'(j, x) / (RS_LAMP_RAYS p(j, x)) = S /
+// RS_LAMP_RAYS where x sees j's emitter (A_j the area of the corners as read), 0 elsewhere.
+// Where the lamps are seen unoccluded the estimate is exact but for the smoke's transmittance and
+// the margins: the lamps' share of the pixel is the pieces' areas, not a count of rays.
+RsReservoir rs_lamp_triangle_candidates(RsDomain D, uint start, uint count, inout RngState rng, out uint uv,
+                                        out vec3 dirY, out float tY) {
+  RsReservoir r = rs_empty();
+  uv = 0u;
+  dirY = vec3(0.0f);
+  tY = 0.0f;
+  float total = 0.0f;
+  for (uint j = 0u; j < count; ++j) total += rs_lamp_weight(start, j);
+  uint j = 0u;
+  float prefix = count > 0u ? rs_lamp_weight(start, 0u) : 0.0f;  // of pieces 0 .. j
+  // One candidate an iteration, so that a subgroup's lanes trace their rays together (a loop over
+  // the pieces with the rays inside would trace as often as the lanes' pieces differ).
+  for (uint i = 0u; i < RS_LAMP_RAYS && count > 0u; ++i) {
+    float next = total * ((float(i) + rng_float(rng)) * (1.0f / float(RS_LAMP_RAYS)));
+    // Its piece: the first whose prefix passes it (rounding's leftovers: the last piece).
+    while (!(next < prefix) && j + 1u < count) prefix += rs_lamp_weight(start, ++j);
+    vec2 a, b, c;
+    uint prim = rs_lamp_piece(start, j, a, b, c);
+    vec2 e1 = b - a, e2 = c - a;
+    float area = 0.5f * abs(e1.x * e2.y - e1.y * e2.x);
+    vec2 bary = surf_uniform_barycentrics(rng_float2(rng));
+    uint x = rs_pack_uv(clamp(a + bary.x * e1 + bary.y * e2, vec2(0.0f), vec2(1.0f)));
+    vec3 dir;
+    float t;
+    float ph = rs_lamp_emitted_by(D, x, prim, dir, t);
+    if (rs_update(r, ph * total * area / (rs_lamp_weight(start, j) * float(RS_LAMP_RAYS)), ph, 0.0f, rng_float(rng))) {
+      uv = x;
+      dirY = dir;
+      tY = t;
+    }
+  }
+  return r;
+}
+#endif
+
+// The lamp reservoir of the pass's pixel from its canonical candidates: p̂, the history's merge,
+// stored in set rsp.lampSet.
+void rs_lamp_reservoir(RsDomain D, uint pixelIndex, RsReservoir r, uint uv, vec3 dirY, float tY, inout RngState rng) {
   r.M = 1.0f;
   rs_finalize(r);
   // p̂(Y) = Le(Y) T(Y), rs_lamp_target's value, without tracing Y's ray again.

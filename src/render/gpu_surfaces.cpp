@@ -137,6 +137,8 @@ GpuSurfaces::GpuSurfaces(gpu::Context& ctx, const Scene& scene) {
       emitterSummary_.push_back({(t.v0 + t.v1 + t.v2) / 3.0f, glm::normalize(glm::cross(t.v1 - t.v0, t.v2 - t.v0)), p});
       emitters.push_back({t.v0, t.v1, t.v2, p, uint32_t(i)});
       emitterVertices_.insert(emitterVertices_.end(), {t.v0, t.v1, t.v2});
+      emitterTriangles_.push_back(uint32_t(i));
+      emitterLuminance_.push_back((le.x + le.y + le.z) * (1.0f / 3.0f));
       t.emitterInvArea = float(1.0 / a);
     }
   }

@@ -49,6 +49,10 @@ class GpuSurfaces {
   uint32_t emitterCount() const { return emitterCount_; }
   // The emissive triangles' corners, three per triangle, as the device holds them (world space).
   const std::vector<glm::vec3>& emitterVertices() const { return emitterVertices_; }
+  // Their triangles' indices on the device (the prim of surface/surfaces.glsl), in that order.
+  const std::vector<uint32_t>& emitterTriangles() const { return emitterTriangles_; }
+  // And their Le's luminance, the mean of its channels (restir/bridge.glsl rs_luminance).
+  const std::vector<float>& emitterLuminance() const { return emitterLuminance_; }
   const geo::BvhStats& bvhStats() const { return stats_; }
   double uploadMs() const { return uploadMs_; }
 
@@ -62,6 +66,8 @@ class GpuSurfaces {
   };
   std::vector<EmitterSummary> emitterSummary_;
   std::vector<glm::vec3> emitterVertices_;
+  std::vector<uint32_t> emitterTriangles_;
+  std::vector<float> emitterLuminance_;
   geo::BvhStats stats_;
   double uploadMs_ = 0.0;
 };

@@ -154,11 +154,24 @@ PixelOrder volumePixelOrder(const shared::GpuCamera& cam, int width, int height,
   return order;
 }
 
-std::vector<uint64_t> emitterPixelRects(const shared::GpuCamera& cam, int width, int height,
-                                        const std::vector<glm::vec3>& vertices) {
+namespace {
+// An emitter triangle's projection in pixel units (x right, y down): the corners of its part in
+// front of the camera's plane, and their bounding rectangle grown by kEmitterPixelMargin.
+struct EmitterProjection {
+  std::array<glm::dvec2, 4> corners;
+  int count = 0;
+  bool clipped = false;  // the camera's plane cut the triangle
+  double xmin = 0, ymin = 0, xmax = 0, ymax = 0;
+};
+
+// Every pixel the emitter triangle k may be seen in (render/pixel_order.h emitterPixelRects: the
+// camera in front of its plane, its projection's bounding rectangle clipped to the front of the
+// camera's plane and grown by kEmitterPixelMargin): visit(k, x, y, projection). False when a
+// projection is not a number (the caller then takes every pixel, whole).
+template <typename Visit>
+bool forEachEmitterPixel(const shared::GpuCamera& cam, int width, int height, const std::vector<glm::vec3>& vertices,
+                         Visit visit) {
   PLUME_CHECK(width > 0 && height > 0 && width <= 65536 && height <= 65536 && vertices.size() % 3 == 0);
-  std::vector<uint64_t> rects(size_t(width) * size_t(height), kNoEmitterRect);
-  auto fixed = [](double t, bool up) { return uint64_t(up ? std::ceil(t * 65535.0) : std::floor(t * 65535.0)); };
   const glm::dvec3 pos(cam.position), fwd(cam.forward), right(cam.right), up(cam.up);
   const double tanY = double(cam.tanHalfFovY), tanX = tanY * double(cam.aspect);
   for (size_t k = 0; k < vertices.size(); k += 3) {
@@ -183,41 +196,129 @@ std::vector<uint64_t> emitterPixelRects(const shared::GpuCamera& cam, int width,
       if ((z[i] - eps) * (z[j] - eps) < 0.0) poly[size_t(count++)] = v[i] + (v[j] - v[i]) * ((eps - z[i]) / (z[j] - z[i]));
     }
     if (count == 0) continue;
+    EmitterProjection pr;
+    pr.count = count;
+    pr.clipped = !(z[0] >= eps && z[1] >= eps && z[2] >= eps);
     double xmin = std::numeric_limits<double>::infinity(), xmax = -xmin, ymin = xmin, ymax = -xmin;
     for (int i = 0; i < count; ++i) {
       const glm::dvec3 d = poly[size_t(i)] - pos;
       const double zc = std::max(glm::dot(d, fwd), eps);
       const double px = (glm::dot(d, right) / zc / tanX + 1.0) * 0.5 * width;
       const double py = (1.0 - glm::dot(d, up) / zc / tanY) * 0.5 * height;
+      pr.corners[size_t(i)] = {px, py};
       xmin = std::min(xmin, px);
       xmax = std::max(xmax, px);
       ymin = std::min(ymin, py);
       ymax = std::max(ymax, py);
     }
-    if (!(std::isfinite(xmin) && std::isfinite(xmax) && std::isfinite(ymin) && std::isfinite(ymax))) {
-      std::fill(rects.begin(), rects.end(), kWholePixelRect);  // (not a number: every pixel, whole)
-      break;
-    }
-    // The pixels [x0, x1) x [y0, y1) whose squares meet the rectangle grown by the margin, and its
-    // part inside each.
+    if (!(std::isfinite(xmin) && std::isfinite(xmax) && std::isfinite(ymin) && std::isfinite(ymax))) return false;
+    // The pixels [x0, x1) x [y0, y1) whose squares meet the rectangle grown by the margin.
     const double m = kEmitterPixelMargin;
     xmin -= m, xmax += m, ymin -= m, ymax += m;
     const int x0 = int(std::clamp(std::floor(xmin), 0.0, double(width)));
     const int x1 = int(std::clamp(std::floor(xmax) + 1.0, 0.0, double(width)));
     const int y0 = int(std::clamp(std::floor(ymin), 0.0, double(height)));
     const int y1 = int(std::clamp(std::floor(ymax) + 1.0, 0.0, double(height)));
-    for (int y = y0; y < y1; ++y) {
-      for (int x = x0; x < x1; ++x) {
-        uint64_t& r = rects[size_t(y) * size_t(width) + size_t(x)];
-        const uint64_t a = std::min(r & 0xffffu, fixed(std::clamp(xmin - x, 0.0, 1.0), false));
-        const uint64_t b = std::min(r >> 16 & 0xffffu, fixed(std::clamp(ymin - y, 0.0, 1.0), false));
-        const uint64_t c = std::max(r >> 32 & 0xffffu, fixed(std::clamp(xmax - x, 0.0, 1.0), true));
-        const uint64_t d = std::max(r >> 48, fixed(std::clamp(ymax - y, 0.0, 1.0), true));
-        r = a | b << 16 | c << 32 | d << 48;
-      }
-    }
+    pr.xmin = xmin, pr.ymin = ymin, pr.xmax = xmax, pr.ymax = ymax;
+    for (int y = y0; y < y1; ++y)
+      for (int x = x0; x < x1; ++x) visit(uint32_t(k / 3), x, y, pr);
   }
+  return true;
+}
+}  // namespace
+
+std::vector<uint64_t> emitterPixelRects(const shared::GpuCamera& cam, int width, int height,
+                                        const std::vector<glm::vec3>& vertices) {
+  std::vector<uint64_t> rects(size_t(width) * size_t(height), kNoEmitterRect);
+  auto fixed = [](double t, bool up) { return uint64_t(up ? std::ceil(t * 65535.0) : std::floor(t * 65535.0)); };
+  // Each pixel's rectangle: the union of the triangles' parts inside it.
+  const bool finite = forEachEmitterPixel(cam, width, height, vertices, [&](uint32_t, int x, int y, const EmitterProjection& p) {
+    uint64_t& r = rects[size_t(y) * size_t(width) + size_t(x)];
+    const uint64_t a = std::min(r & 0xffffu, fixed(std::clamp(p.xmin - x, 0.0, 1.0), false));
+    const uint64_t b = std::min(r >> 16 & 0xffffu, fixed(std::clamp(p.ymin - y, 0.0, 1.0), false));
+    const uint64_t c = std::max(r >> 32 & 0xffffu, fixed(std::clamp(p.xmax - x, 0.0, 1.0), true));
+    const uint64_t d = std::max(r >> 48, fixed(std::clamp(p.ymax - y, 0.0, 1.0), true));
+    r = a | b << 16 | c << 32 | d << 48;
+  });
+  if (!finite) std::fill(rects.begin(), rects.end(), kWholePixelRect);  // (not a number: every pixel, whole)
   return rects;
+}
+
+namespace {
+// The convex polygon p (pixel units) cut to pixel (x, y)'s square (Sutherland-Hodgman), in that
+// pixel's own (u, v).
+std::vector<glm::dvec2> clipToPixel(std::vector<glm::dvec2> p, int x, int y) {
+  for (glm::dvec2& c : p) c -= glm::dvec2(x, y);
+  std::vector<glm::dvec2> q;
+  for (int side = 0; side < 4; ++side) {
+    const int axis = side / 2;
+    const double bound = double(side % 2), sign = side % 2 ? -1.0 : 1.0;
+    q.clear();
+    for (size_t i = 0; i < p.size(); ++i) {
+      const glm::dvec2 a = p[i], b = p[(i + 1) % p.size()];
+      const double da = sign * (a[axis] - bound), db = sign * (b[axis] - bound);
+      if (da >= 0.0) q.push_back(a);
+      if ((da >= 0.0) != (db >= 0.0)) q.push_back(a + (b - a) * (da / (da - db)));
+    }
+    std::swap(p, q);
+  }
+  for (glm::dvec2& c : p) c = glm::clamp(c, 0.0, 1.0);  // (rounding's overshoot)
+  return p;
+}
+
+double twiceArea(glm::dvec2 a, glm::dvec2 b, glm::dvec2 c) { return std::abs((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x)); }
+
+// The region of pixel (x, y) that the lamp reservoir draws emitter triangle p's rays on: its
+// projection with every edge moved out by kEmitterRegionGrowth (the triangle scaled about its
+// incentre), cut to the square; the whole square where the camera's plane cuts the triangle;
+// nothing where the projection is a segment (seen edge on).
+std::vector<glm::dvec2> emitterRegion(const EmitterProjection& p, int x, int y) {
+  if (p.clipped) return {{0.0, 0.0}, {1.0, 0.0}, {1.0, 1.0}, {0.0, 1.0}};
+  const glm::dvec2 a = p.corners[0], b = p.corners[1], c = p.corners[2];
+  const double la = glm::length(b - c), lb = glm::length(c - a), lc = glm::length(a - b);
+  const double perimeter = la + lb + lc, inradius = twiceArea(a, b, c) / perimeter;
+  if (!(inradius > 1e-12)) return {};
+  const glm::dvec2 centre = (la * a + lb * b + lc * c) / perimeter;
+  const double scale = 1.0 + kEmitterRegionGrowth / inradius;
+  return clipToPixel({centre + scale * (a - centre), centre + scale * (b - centre), centre + scale * (c - centre)}, x, y);
+}
+}  // namespace
+
+double polygonAreaInPixel(const std::vector<glm::dvec2>& corners, int x, int y) {
+  const std::vector<glm::dvec2> p = clipToPixel(corners, x, y);
+  double twice = 0.0;
+  for (size_t i = 2; i < p.size(); ++i) twice += twiceArea(p[0], p[i - 1], p[i]);
+  return 0.5 * twice;
+}
+
+EmitterPixelLists emitterPixelTriangles(const shared::GpuCamera& cam, int width, int height,
+                                        const std::vector<glm::vec3>& vertices) {
+  const size_t n = size_t(width) * size_t(height);
+  EmitterPixelLists lists;
+  lists.begin.assign(n + 1, 0u);
+  // Each pixel's pieces, in the pixels' order: gathered per pixel, then laid out.
+  std::vector<std::vector<EmitterPiece>> pieces(n);
+  auto add = [&](uint32_t k, int x, int y, const EmitterProjection& p) {
+    const std::vector<glm::dvec2> r = emitterRegion(p, x, y);
+    for (size_t i = 2; i < r.size(); ++i) {
+      const double area = 0.5 * twiceArea(r[0], r[i - 1], r[i]);
+      if (area > 0.0) pieces[size_t(y) * size_t(width) + size_t(x)].push_back({k, float(area), glm::vec2(r[0]), glm::vec2(r[i - 1]), glm::vec2(r[i])});
+    }
+  };
+  if (!forEachEmitterPixel(cam, width, height, vertices, add)) {
+    // (not a number: every triangle in every pixel, each drawn on the whole of it)
+    EmitterProjection whole;
+    whole.clipped = true;
+    for (auto& list : pieces) list.clear();
+    for (int y = 0; y < height; ++y)
+      for (int x = 0; x < width; ++x)
+        for (uint32_t k = 0; k < uint32_t(vertices.size() / 3); ++k) add(k, x, y, whole);
+  }
+  for (size_t i = 0; i < n; ++i) {
+    lists.begin[i + 1] = lists.begin[i] + uint32_t(pieces[i].size());
+    lists.pieces.insert(lists.pieces.end(), pieces[i].begin(), pieces[i].end());
+  }
+  return lists;
 }
 
 std::vector<uint32_t> emitterPixelMask(const std::vector<uint64_t>& rects) {

@@ -72,6 +72,31 @@ constexpr uint64_t kWholePixelRect = uint64_t(0xffffffffu) << 32;      // [0, 1]
 std::vector<uint64_t> emitterPixelRects(const shared::GpuCamera& cam, int width, int height,
                                         const std::vector<glm::vec3>& vertices);
 
+// Where ReSTIR's lamp reservoir draws its camera rays (restir/candidates.glsl
+// rs_lamp_triangle_candidates): for each pixel, each emitter triangle that its grown rectangle
+// above meets contributes the region of the pixel's (u, v) that its projection covers, with every
+// edge moved out by kEmitterRegionGrowth pixels (far above the rounding of the projection and of a
+// device's camera rays, so the region holds every (u, v) whose ray meets the triangle; the whole
+// pixel where the camera's plane cuts the triangle), cut to the pixel's square and split into a fan
+// of triangles, the pieces. Pixel i's pieces are pieces[begin[i] .. begin[i + 1]), by increasing
+// triangle index (into `vertices` / 3). Every triangle in every pixel, each on the whole of it,
+// where a projection is not a number.
+constexpr double kEmitterRegionGrowth = 1.0 / 1024.0;
+struct EmitterPiece {
+  uint32_t triangle = 0;  // index into `vertices` / 3
+  float area = 0.0f;      // in square pixels (> 0)
+  glm::vec2 a, b, c;      // corners, in the pixel's (u, v)
+};
+struct EmitterPixelLists {
+  std::vector<uint32_t> begin;  // width * height + 1 offsets
+  std::vector<EmitterPiece> pieces;
+};
+EmitterPixelLists emitterPixelTriangles(const shared::GpuCamera& cam, int width, int height,
+                                        const std::vector<glm::vec3>& vertices);
+
+// The area of the convex polygon `corners` (pixel units, x right, y down) inside pixel (x, y)'s square.
+double polygonAreaInPixel(const std::vector<glm::dvec2>& corners, int x, int y);
+
 // The pixels that have a rectangle: bit i % 32 of word i / 32 for pixel i = y * width + x.
 std::vector<uint32_t> emitterPixelMask(const std::vector<uint64_t>& rects);
 

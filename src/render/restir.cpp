@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <numeric>
 
 namespace plume {
 
@@ -98,6 +99,7 @@ std::vector<shared::GpuLightChoice> lightChoice(const Scene& scene, glm::vec3 ce
 }
 
 constexpr uint32_t kSets = shared::RS_SETS;
+constexpr size_t kLampPieceWords = 8;  // a piece of an emitter's projection (restir/bindings.glsl rs_lamp_piece)
 
 }  // namespace
 
@@ -206,7 +208,12 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   };
   candidates_ = make("passes/restir_candidates.comp", "restir candidates", {});
   // The lamps seen directly, over the pixels whose camera rays may meet an emitter (restir/candidates.glsl).
-  if (features_.emitters) lamps_ = make("passes/restir_lamps.comp", "restir lamps", {});
+  if (features_.emitters) {
+    gpu::ShaderDefines lampDefines;
+    if (lampTriangles()) lampDefines.emplace_back("PLUME_RS_LAMP_TRIANGLES", "1");
+    lamps_ = make("passes/restir_lamps.comp", "restir lamps", lampDefines);
+    if (lampTriangles()) lampsRect_ = make("passes/restir_lamps.comp", "restir lamps in rectangles", {});
+  }
   temporal_ = make("passes/restir_reuse.comp", "restir temporal", {{"PLUME_RS_TEMPORAL", "1"}});
   // Temporal reuse where the history's domain is the current one (params_.historySameDomain):
   // the identity shift and stored targets only, no target evaluation compiled in (restir/reuse.glsl).
@@ -323,7 +330,7 @@ std::vector<gpu::ComputePass*> Restir::passes() const {
   std::vector<gpu::ComputePass*> p = {candidates_.get(), temporal_.get(), temporalSame_.get(), spatial_.get(),
                                       shade_.get()};
   for (gpu::ComputePass* q : {candidatesOut_.get(), temporalOut_.get(), spatialOut_.get(), shadeOut_.get(), tail_.get(),
-                              lamps_.get()}) {
+                              lamps_.get(), lampsRect_.get()}) {
     if (q) p.push_back(q);
   }
   return p;
@@ -372,26 +379,108 @@ void Restir::fillFrame(int frame, uint32_t sequence, uint32_t key) {
   if (pixelOrder_.pixels.empty() || !sameCamera(orderCam_, cam) || orderSerial_ != currentSerial_) {
     const int w = scene_.camera.width, h = scene_.camera.height;
     pixelOrder_ = candidatesOut_ ? volumePixelOrder(cam, w, h, footprint_) : allPixels(w, h);
-    paramBuffer_.upload(pixelOrder_.pixels.data(), pixelOrder_.pixels.size() * sizeof(uint32_t),
-                        sizeof(shared::RestirParams));
+    std::vector<uint32_t> lamps;
     if (lamps_) {
       // The mask, then its pixels in the passes' order (the lamp pass's list; with surfaces every
-      // pixel is inside, so that is tile order), then their rectangles in the list's order.
+      // pixel is inside, so that is tile order), then two words for each of them: its rectangle,
+      // or with RestirOptions::lampTriangles the start and length of its list of pieces of emitter
+      // projections (render/pixel_order.h emitterPixelTriangles), which follow, kLampPieceWords
+      // words each (restir/bindings.glsl rs_lamp_piece). Where the pieces would not fit the
+      // device's largest storage buffer, the pixels with the most pieces draw in their rectangles
+      // instead, a list of their own after the others' words (lampsRect_), counted and logged.
       const size_t n = size_t(w) * size_t(h);
+      const bool triangles = lampTriangles();
       std::vector<uint64_t> rects = options_.cullLampPixels ? emitterPixelRects(cam, w, h, surfaces_->emitterVertices())
                                                             : std::vector<uint64_t>(n, kWholePixelRect);
-      std::vector<uint32_t> lamps = emitterPixelMask(rects);
-      const size_t maskWords = lamps.size();
-      std::vector<uint64_t> listRects;
+      const EmitterPixelLists lists =
+          triangles ? emitterPixelTriangles(cam, w, h, surfaces_->emitterVertices()) : EmitterPixelLists{};
+      lamps = emitterPixelMask(rects);
+      std::vector<size_t> listed;
       for (uint32_t packed : pixelOrder_.pixels) {
         const size_t i = size_t(packed >> 16) * size_t(w) + (packed & 0xffffu);
-        if ((lamps[i / 32] >> (i % 32)) & 1u) {
-          lamps.push_back(packed);
-          listRects.push_back(options_.lampRects ? rects[i] : kWholePixelRect);
+        if (!((lamps[i / 32] >> (i % 32)) & 1u)) continue;
+        // (a pixel that the rectangles mark but no piece reaches sees no emitter: out of the mask)
+        if (triangles && lists.begin[i + 1] == lists.begin[i]) {
+          lamps[i / 32] &= ~(1u << (i % 32));
+          continue;
+        }
+        listed.push_back(i);
+      }
+      lampPixels_ = uint32_t(listed.size());
+      std::vector<bool> inRect(listed.size(), !triangles);
+      if (triangles) {
+        const size_t device = (ctx_.limits().maxStorageBufferRange - sizeof(shared::RestirParams)) / sizeof(uint32_t);
+        const size_t used = pixelOrder_.pixels.size() + lamps.size() + 3 * listed.size();
+        const size_t limit = options_.lampPieceWords > 0 ? options_.lampPieceWords : device > used ? device - used : 0;
+        size_t words = 0;
+        for (size_t l = 0; l < listed.size(); ++l) words += kLampPieceWords * (lists.begin[listed[l] + 1] - lists.begin[listed[l]]);
+        std::vector<size_t> byPieces(listed.size());
+        std::iota(byPieces.begin(), byPieces.end(), size_t(0));
+        std::stable_sort(byPieces.begin(), byPieces.end(), [&](size_t a, size_t b) {
+          return lists.begin[listed[a] + 1] - lists.begin[listed[a]] > lists.begin[listed[b] + 1] - lists.begin[listed[b]];
+        });
+        for (size_t l : byPieces) {
+          if (words <= limit) break;
+          inRect[l] = true;
+          words -= kLampPieceWords * (lists.begin[listed[l] + 1] - lists.begin[listed[l]]);
         }
       }
-      lampPixels_ = uint32_t(lamps.size() - maskWords);
-      for (uint64_t r : listRects) lamps.insert(lamps.end(), {uint32_t(r), uint32_t(r >> 32)});
+      lampRectPixels_ = triangles ? uint32_t(std::count(inRect.begin(), inRect.end(), true)) : 0u;
+      if (lampRectPixels_ > 0 && !lampRectWarned_) {
+        logWarn(strf("restir: %u of %u pixels that may see an emitter draw their lamp rays in rectangles, not on the "
+                     "emitters' pieces: the pieces would pass the device's largest storage buffer (%.0f MiB)",
+                     lampRectPixels_, lampPixels_, ctx_.limits().maxStorageBufferRange / 1048576.0));
+        lampRectWarned_ = true;
+      }
+      // The two lists, each followed by its pixels' words, then the pieces.
+      const size_t first = pixelOrder_.pixels.size() + lamps.size() + 3 * listed.size();  // (in rsPixels)
+      size_t next = first;
+      for (const bool rect : {false, true}) {
+        if (triangles && rect) lampRectListBegin_ = uint32_t(pixelOrder_.pixels.size() + lamps.size());
+        for (size_t l = 0; l < listed.size(); ++l) {
+          if (inRect[l] != rect) continue;
+          const size_t i = listed[l];
+          lamps.push_back(packPixel(uint32_t(i % size_t(w)), uint32_t(i / size_t(w))));
+        }
+        for (size_t l = 0; l < listed.size(); ++l) {
+          if (inRect[l] != rect) continue;
+          const size_t i = listed[l];
+          if (!rect) {
+            const uint32_t count = lists.begin[i + 1] - lists.begin[i];
+            lamps.insert(lamps.end(), {uint32_t(next), count});
+            next += kLampPieceWords * size_t(count);
+          } else {
+            const uint64_t r = options_.lampRects ? rects[i] : kWholePixelRect;
+            lamps.insert(lamps.end(), {uint32_t(r), uint32_t(r >> 32)});
+          }
+        }
+      }
+      PLUME_CHECK(pixelOrder_.pixels.size() + lamps.size() == first);
+      for (size_t l = 0; l < listed.size(); ++l) {
+        if (inRect[l]) continue;
+        for (uint32_t j = lists.begin[listed[l]]; j < lists.begin[listed[l] + 1]; ++j) {
+          // The triangle's device index, its weight Le's luminance x the piece's area, the corners.
+          const EmitterPiece& e = lists.pieces[j];
+          const float weight = surfaces_->emitterLuminance()[e.triangle] * e.area;
+          for (uint32_t word : {surfaces_->emitterTriangles()[e.triangle], std::bit_cast<uint32_t>(weight),
+                                std::bit_cast<uint32_t>(e.a.x), std::bit_cast<uint32_t>(e.a.y), std::bit_cast<uint32_t>(e.b.x),
+                                std::bit_cast<uint32_t>(e.b.y), std::bit_cast<uint32_t>(e.c.x), std::bit_cast<uint32_t>(e.c.y)}) {
+            lamps.push_back(word);
+          }
+        }
+      }
+      PLUME_CHECK(pixelOrder_.pixels.size() + lamps.size() == next);
+    }
+    // The buffer grows where this frame's lists need more room (and is bound again).
+    const size_t bytes = sizeof(shared::RestirParams) + (pixelOrder_.pixels.size() + lamps.size()) * sizeof(uint32_t);
+    if (bytes > paramBuffer_.size()) {
+      paramBuffer_ = gpu::Buffer(ctx_, bytes + bytes / 2, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "restir parameters");
+      for (gpu::ComputePass* p : passes()) p->set.bind(shared::BIND_RS_PARAMS, paramBuffer_);
+      paramBuffer_.upload(&params_, sizeof(params_));
+    }
+    paramBuffer_.upload(pixelOrder_.pixels.data(), pixelOrder_.pixels.size() * sizeof(uint32_t),
+                        sizeof(shared::RestirParams));
+    if (!lamps.empty()) {
       paramBuffer_.upload(lamps.data(), lamps.size() * sizeof(uint32_t),
                           sizeof(shared::RestirParams) + pixelOrder_.pixels.size() * sizeof(uint32_t));
     }
@@ -444,7 +533,12 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
     const uint32_t candidates = timer_.begin(cmd, "restir candidates");
     if (lamps_) {  // (its pixels' lamp reservoirs; the candidates pass writes the others')
       const uint32_t listBegin = all + (all + 31) / 32;
-      over(*lamps_, push, listBegin, lampPixels_);
+      if (lampsRect_) {
+        over(*lamps_, push, listBegin, lampPixels_ - lampRectPixels_);
+        over(*lampsRect_, push, lampRectListBegin_, lampRectPixels_);
+      } else {
+        over(*lamps_, push, listBegin, lampPixels_);
+      }
     }
     for (uint32_t m = 0; m < params_.candidates; m += params_.walksPerDispatch) {
       if (m > 0) gpu::computeBarrier(cmd);

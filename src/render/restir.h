@@ -64,10 +64,16 @@ struct RestirOptions {
   // whose rays may meet an emitter's front (render/pixel_order.h emitterPixelMask; the others'
   // reservoirs are empty either way); the two must give one image, bit for bit.
   bool cullLampPixels = true;
-  // Tests only: false draws the lamp reservoir's camera rays over the whole of each pixel,
-  // instead of over the rectangle of it where an emitter's front may be seen
-  // (render/pixel_order.h emitterPixelRects); same expectation, other images.
+  // Tests only: false draws the lamp reservoir's camera rays on the rectangle of each pixel where an
+  // emitter's front may be seen (render/pixel_order.h emitterPixelRects), or without lampRects on
+  // the whole pixel, instead of on the pieces of the pixel that the emitters' projections cover,
+  // chosen by Le times their area (emitterPixelTriangles; restir/candidates.glsl
+  // rs_lamp_triangle_candidates); same expectation, other images. Only with cullLampPixels.
+  bool lampTriangles = true;
   bool lampRects = true;
+  // Tests only: the words of the parameter buffer the pieces may take (0: as many as the device's
+  // largest storage buffer leaves); pixels past it draw in their rectangles (lampRectPixels()).
+  size_t lampPieceWords = 0;
   // Tests only: true keeps the stored paths' vertices in a storage buffer (PLUME_RS_VERTEX_BUFFER)
   // as on a device whose texel buffers cannot hold them but whose storage buffers can (otherwise
   // the device's limits choose: Restir::Restir); the two must give one image, bit for bit.
@@ -113,6 +119,10 @@ class Restir {
   // Pixels of the last frame whose lamp reservoir traced its camera rays (emitterPixelMask; every
   // pixel without options().cullLampPixels; 0 without emissive surfaces).
   uint32_t lampPixels() const { return lampPixels_; }
+  // Of those, the pixels that drew their rays in their rectangles although the pieces were asked
+  // for (RestirOptions::lampTriangles): their pieces would not fit the device's storage buffer
+  // (the pixels with the most pieces go first; logged as a warning).
+  uint32_t lampRectPixels() const { return lampRectPixels_; }
 
  private:
   void fillFrame(int frame, uint32_t sequence, uint32_t key);
@@ -132,6 +142,7 @@ class Restir {
   std::unique_ptr<GpuSurfaces> surfaces_;  // only for a scene with surfaces
   std::unique_ptr<gpu::ComputePass> candidates_, temporal_, temporalSame_, spatial_, shade_;
   std::unique_ptr<gpu::ComputePass> lamps_;  // the lamps seen directly (only with emissive surfaces)
+  std::unique_ptr<gpu::ComputePass> lampsRect_;  // with pieces, for the pixels whose pieces do not fit
   // The passes' variants for the pixels whose camera rays miss the volume (PLUME_RS_OUTSIDE;
   // null with surfaces, or without options_.cullOutside).
   std::unique_ptr<gpu::ComputePass> candidatesOut_, temporalOut_, spatialOut_, shadeOut_;
@@ -160,6 +171,10 @@ class Restir {
   PixelOrder pixelOrder_;
   int rounds_ = 1;  // this frame's spatial rounds (options_.rounds, or roundsStatic where nothing changed)
   uint32_t lampPixels_ = 0;  // the lamp pass's list (after the order and the mask in paramBuffer_)
+  uint32_t lampRectPixels_ = 0;  // its last ones, those of lampsRect_ (after the first ones' words)
+  uint32_t lampRectListBegin_ = 0;  // where their list starts in rsPixels
+  bool lampRectWarned_ = false;
+  bool lampTriangles() const { return options_.lampTriangles && options_.cullLampPixels; }
   shared::GpuCamera orderCam_{};
   uint64_t orderSerial_ = 0;
   PassTimes passTimes_;
