@@ -911,3 +911,37 @@ TEST_F(GpuRestir, ImageTooLargeForTheDeviceIsAClearErrorBeforeCompiling) {
     EXPECT_LE(double(w) * h * double(bytesPerPixel), storageLimit) << m;
   }
 }
+
+// The other side of the limits: an image within them renders. ReSTIR's per-pixel arrays are
+// storage texel buffers, bounded by maxTexelBufferElements (lavapipe: 2^27 texels, 2 GiB) and not
+// by the storage buffer range (128 MiB); from session 28 to 33 they were created as storage
+// buffers too (for the path tracer's slots, which alone need it), and `plume render --mode restir`
+// failed at 1280x720 ("reservoir paths and pass state needs 154.7 MiB, more than the device's
+// storage buffer limit"). 1920x1080 at 4 bounces: its paths and pass state need 11 texels a pixel,
+// 348 MiB; one frame renders, every pixel finite (with the flag back on every texel buffer it
+// throws that error again).
+TEST_F(GpuRestir, FullHdImageRendersWhereItsTexelArraysPassTheStorageBufferRange) {
+  Scene s = baseScene(8);
+  s.camera.width = 1920;
+  s.camera.height = 1080;
+  s.render.maxBounces = 4;
+  const double pathBytes = (3.0 * 2.0 + 5.0) * 16.0 * 1920.0 * 1080.0;
+  std::printf("[restir] 1920x1080: paths and pass state %.0f MiB; the device's storage buffer range %.0f MiB, "
+              "texel buffers %u texels\n",
+              pathBytes / 1048576.0, ctx().limits().maxStorageBufferRange / 1048576.0, ctx().limits().maxTexelBufferElements);
+  if (pathBytes <= double(ctx().limits().maxStorageBufferRange)) {
+    std::printf("[restir] (this device's storage buffers would hold them: the test shows nothing here)\n");
+  }
+  const auto volumes = noiseVolumes(ctx(), s, {3});
+  Restir restir(ctx(), compiler(), s, RestirOptions{});
+  restir.setVolumes(*volumes[0], *volumes[0]);
+  const Image image = restir.renderFrame(1, 1);
+  ASSERT_EQ(image.rgb.size(), size_t(3) * 1920 * 1080);
+  size_t nonFinite = 0, lit = 0;
+  for (float v : image.rgb) {
+    nonFinite += std::isfinite(v) ? 0 : 1;
+    lit += v > 0.0f ? 1 : 0;
+  }
+  EXPECT_EQ(nonFinite, 0u);
+  EXPECT_GT(lit, image.rgb.size() / 10);
+}

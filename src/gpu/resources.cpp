@@ -115,7 +115,7 @@ void Buffer::fillZero() {
 
 // ---------------------------------------------------------------------------------------------
 TexelBuffer::TexelBuffer(Context& ctx, const void* data, size_t count, VkFormat format, const std::string& name,
-                         bool storage)
+                         bool storage, bool alsoStorageBuffer)
     : ctx_(&ctx) {
   PLUME_CHECK(format == VK_FORMAT_R32_SFLOAT || format == VK_FORMAT_R32_UINT ||
               format == VK_FORMAT_R32G32B32A32_SFLOAT || format == VK_FORMAT_R32G32B32A32_UINT);
@@ -128,8 +128,8 @@ TexelBuffer::TexelBuffer(Context& ctx, const void* data, size_t count, VkFormat 
                           kTooLargeHint));
   }
   buffer_ = Buffer(ctx, count * texelBytes,
-                   storage ? VK_BUFFER_USAGE_STORAGE_TEXEL_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
-                                 VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT
+                   storage ? VK_BUFFER_USAGE_STORAGE_TEXEL_BUFFER_BIT | VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT |
+                                 (alsoStorageBuffer ? VkBufferUsageFlags(VK_BUFFER_USAGE_STORAGE_BUFFER_BIT) : 0u)
                            : VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT,
                    name);
   if (data && given > 0) buffer_.upload(data, given * texelBytes);

@@ -58,11 +58,14 @@ class TexelBuffer {
   // `format`: VK_FORMAT_R32_SFLOAT, VK_FORMAT_R32_UINT (4 bytes per element),
   // VK_FORMAT_R32G32B32A32_SFLOAT or _UINT (16); `count` elements, uploaded from `data` where
   // not null. `storage`: a storage texel buffer (imageBuffer, read and written; zeroed with
-  // fillZero) instead of a uniform one (samplerBuffer, read only); its buffer() may then also be
-  // bound as a storage buffer and the view as a uniform texel buffer (the path tracer's slots:
-  // written word by word, read a texel at a time).
+  // fillZero) instead of a uniform one (samplerBuffer, read only); its view may then also be bound
+  // as a uniform texel buffer. `alsoStorageBuffer` (with `storage`): its buffer() may be bound as
+  // a storage buffer too (the path tracer's slots: written word by word, read a texel at a time),
+  // which bounds its size by the device's storage buffer range, not only its texel count (a
+  // storage texel buffer alone holds up to maxTexelBufferElements texels: lavapipe's 2^27 texels
+  // are 2 GiB, its storage buffers 128 MiB; ReSTIR's per-pixel arrays need the former at 720p).
   TexelBuffer(Context& ctx, const void* data, size_t count, VkFormat format, const std::string& name,
-              bool storage = false);
+              bool storage = false, bool alsoStorageBuffer = false);
   ~TexelBuffer();
   TexelBuffer(TexelBuffer&& o) noexcept { *this = std::move(o); }
   TexelBuffer& operator=(TexelBuffer&& o) noexcept;

@@ -68,7 +68,7 @@ PathTracer::PathTracer(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const S
                          n == pixels ? std::string("accumulation") : strf("accumulation part %zu", accums_.size()));
   }
   paths_ = gpu::TexelBuffer(ctx, nullptr, size_t(slots_) * shared::PT_PATH_TEXELS, VK_FORMAT_R32G32B32A32_UINT,
-                           "path slots", true);
+                           "path slots", true, true);
   queues_ = gpu::Buffer(ctx, size_t(slots_) * 2 * sizeof(uint32_t), storage, "path queues");
   wave_ = gpu::Buffer(ctx, sizeof(shared::PtWave), storage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, "path queue lengths");
   // The pixel list, ordered by each frame's first addSamples (orderPixels); only with the
