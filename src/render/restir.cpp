@@ -474,7 +474,9 @@ void Restir::fillFrame(int frame, uint32_t sequence, uint32_t key) {
     // The buffer grows where this frame's lists need more room (and is bound again).
     const size_t bytes = sizeof(shared::RestirParams) + (pixelOrder_.pixels.size() + lamps.size()) * sizeof(uint32_t);
     if (bytes > paramBuffer_.size()) {
-      paramBuffer_ = gpu::Buffer(ctx_, bytes + bytes / 2, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "restir parameters");
+      // (room to grow by half, within the device's range, which the pieces' budget above keeps bytes in)
+      const size_t capacity = std::max<size_t>(bytes, std::min<size_t>(bytes + bytes / 2, ctx_.limits().maxStorageBufferRange));
+      paramBuffer_ = gpu::Buffer(ctx_, capacity, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "restir parameters");
       for (gpu::ComputePass* p : passes()) p->set.bind(shared::BIND_RS_PARAMS, paramBuffer_);
       paramBuffer_.upload(&params_, sizeof(params_));
     }
