@@ -296,28 +296,34 @@ EmitterPixelLists emitterPixelTriangles(const shared::GpuCamera& cam, int width,
   const size_t n = size_t(width) * size_t(height);
   EmitterPixelLists lists;
   lists.begin.assign(n + 1, 0u);
-  // Each pixel's pieces, in the pixels' order: gathered per pixel, then laid out.
-  std::vector<std::vector<EmitterPiece>> pieces(n);
+  // The pieces as the triangles give them, with their pixels; then laid out by pixel (a counting
+  // sort, stable: by increasing triangle within a pixel).
+  std::vector<EmitterPiece> found;
+  std::vector<uint32_t> pixelOf;
   auto add = [&](uint32_t k, int x, int y, const EmitterProjection& p) {
     const std::vector<glm::dvec2> r = emitterRegion(p, x, y);
     for (size_t i = 2; i < r.size(); ++i) {
       const double area = 0.5 * twiceArea(r[0], r[i - 1], r[i]);
-      if (area > 0.0) pieces[size_t(y) * size_t(width) + size_t(x)].push_back({k, float(area), glm::vec2(r[0]), glm::vec2(r[i - 1]), glm::vec2(r[i])});
+      if (!(area > 0.0)) continue;
+      found.push_back({k, float(area), glm::vec2(r[0]), glm::vec2(r[i - 1]), glm::vec2(r[i])});
+      pixelOf.push_back(uint32_t(size_t(y) * size_t(width) + size_t(x)));
     }
   };
   if (!forEachEmitterPixel(cam, width, height, vertices, add)) {
     // (not a number: every triangle in every pixel, each drawn on the whole of it)
     EmitterProjection whole;
     whole.clipped = true;
-    for (auto& list : pieces) list.clear();
+    found.clear();
+    pixelOf.clear();
     for (int y = 0; y < height; ++y)
       for (int x = 0; x < width; ++x)
         for (uint32_t k = 0; k < uint32_t(vertices.size() / 3); ++k) add(k, x, y, whole);
   }
-  for (size_t i = 0; i < n; ++i) {
-    lists.begin[i + 1] = lists.begin[i] + uint32_t(pieces[i].size());
-    lists.pieces.insert(lists.pieces.end(), pieces[i].begin(), pieces[i].end());
-  }
+  for (uint32_t i : pixelOf) ++lists.begin[size_t(i) + 1];
+  for (size_t i = 0; i < n; ++i) lists.begin[i + 1] += lists.begin[i];
+  lists.pieces.resize(found.size());
+  std::vector<uint32_t> next(lists.begin.begin(), lists.begin.end() - 1);
+  for (size_t j = 0; j < found.size(); ++j) lists.pieces[next[pixelOf[j]]++] = found[j];
   return lists;
 }
 

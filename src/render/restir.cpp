@@ -414,11 +414,14 @@ void Restir::fillFrame(int frame, uint32_t sequence, uint32_t key) {
         const size_t limit = options_.lampPieceWords > 0 ? options_.lampPieceWords : device > used ? device - used : 0;
         size_t words = 0;
         for (size_t l = 0; l < listed.size(); ++l) words += kLampPieceWords * (lists.begin[listed[l] + 1] - lists.begin[listed[l]]);
-        std::vector<size_t> byPieces(listed.size());
-        std::iota(byPieces.begin(), byPieces.end(), size_t(0));
-        std::stable_sort(byPieces.begin(), byPieces.end(), [&](size_t a, size_t b) {
-          return lists.begin[listed[a] + 1] - lists.begin[listed[a]] > lists.begin[listed[b] + 1] - lists.begin[listed[b]];
-        });
+        std::vector<size_t> byPieces;  // (only where they do not all fit)
+        if (words > limit) {
+          byPieces.resize(listed.size());
+          std::iota(byPieces.begin(), byPieces.end(), size_t(0));
+          std::stable_sort(byPieces.begin(), byPieces.end(), [&](size_t a, size_t b) {
+            return lists.begin[listed[a] + 1] - lists.begin[listed[a]] > lists.begin[listed[b] + 1] - lists.begin[listed[b]];
+          });
+        }
         for (size_t l : byPieces) {
           if (words <= limit) break;
           inRect[l] = true;
