@@ -147,14 +147,16 @@ Chi2Result chi2Test(std::span<const double> observed, std::span<const double> ex
 }
 
 // --- relMSE and mean ratio ----------------------------------------------------------------
+double relMseTerm(float x, float reference) {
+  const double d = double(x) - reference, r = reference;
+  return d * d / (r * r + 1e-2);
+}
+
 double relMse(std::span<const float> x, std::span<const float> reference) {
   PLUME_CHECK(x.size() == reference.size());
   if (x.empty()) return 0.0;
   double sum = 0.0;
-  for (size_t i = 0; i < x.size(); ++i) {
-    const double d = double(x[i]) - reference[i], r = reference[i];
-    sum += d * d / (r * r + 1e-2);
-  }
+  for (size_t i = 0; i < x.size(); ++i) sum += relMseTerm(x[i], reference[i]);
   return sum / double(x.size());
 }
 
@@ -179,8 +181,7 @@ std::vector<double> pixelTerms(const Image& x, const Image& reference, double& t
   std::vector<double> terms(size_t(x.width) * size_t(x.height), 0.0);
   total = 0.0;
   for (size_t i = 0; i < x.rgb.size(); ++i) {
-    const double d = double(x.rgb[i]) - reference.rgb[i], r = reference.rgb[i];
-    const double t = d * d / (r * r + 1e-2);
+    const double t = relMseTerm(x.rgb[i], reference.rgb[i]);
     terms[i / 3] += t;
     total += t;
   }

@@ -56,7 +56,9 @@ double twoSidedPValue(double z);  // P(|Z| >= |z|) for a standard normal Z
 double sidakLevel(double alpha, double count);
 
 // --- Errors between images (DESIGN §6) --------------------------------------------------
-// mean over pixels and channels of (x - r)^2 / (r^2 + 1e-2); x, r: equal-length rgb arrays.
+// One channel's term, (x - r)^2 / (r^2 + 1e-2).
+double relMseTerm(float x, float reference);
+// mean over pixels and channels of relMseTerm; x, r: equal-length rgb arrays.
 double relMse(std::span<const float> x, std::span<const float> reference);
 double relMse(const Image& x, const Image& reference);  // throws InputError on a size mismatch
 // Where relMSE sits: each pixel's share of it (the sum of its three channels' terms over the
