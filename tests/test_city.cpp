@@ -182,9 +182,13 @@ TEST(CityEmitters, LightTreeSamplesThousandsOfEmittersAsItsProbabilitiesSay) {
     return glm::cross(e.v1 - e.v0, e.v2 - e.v0).y < 0.0f;
   });
   const glm::vec3 underLamp = (lamp.v0 + lamp.v1 + lamp.v2) / 3.0f - glm::vec3(0.0f, 0.04f, 0.0f);
-  const std::vector<glm::vec3> points = {{0.0f, 0.5f, 0.0f}, underLamp, {1.9f, 0.01f, 0.35f}, {0.3f, 6.0f, -0.2f}};
+  // Points in the smoke and above the city (no receiver), and on the ground under the lamp and in
+  // a street (the ground's normal): the receiver bound of surface points is sampled too.
+  const glm::vec3 up(0.0f, 1.0f, 0.0f);
+  const std::vector<std::pair<glm::vec3, glm::vec3>> points = {
+      {{0.0f, 0.5f, 0.0f}, glm::vec3(0.0f)}, {underLamp, up}, {{1.9f, 0.01f, 0.35f}, up}, {{0.3f, 6.0f, -0.2f}, glm::vec3(0.0f)}};
   uint32_t stream = 0;
-  for (const glm::vec3& x : points) {
+  for (const auto& [x, r] : points) {
     // One bin per emitter, and one for "no sample" (the descent reached a node none of whose
     // emitters faces x), whose probability is what the emitters' leave.
     const size_t none = emitters.size();
@@ -193,7 +197,7 @@ TEST(CityEmitters, LightTreeSamplesThousandsOfEmittersAsItsProbabilitiesSay) {
     double sum = 0.0;
     for (size_t i = 0; i < none; ++i) {
       index[emitters[i].triangle] = i;
-      expected[i] = shared::lt_pmf(x, tree.trails[i]);
+      expected[i] = shared::lt_pmf(x, r, tree.trails[i]);
       sum += expected[i];
     }
     EXPECT_LE(sum, 1.0 + 1e-4);
@@ -203,7 +207,7 @@ TEST(CityEmitters, LightTreeSamplesThousandsOfEmittersAsItsProbabilitiesSay) {
     shared::RngState rng = shared::rng_init(shared::uvec2(7u, stream++), 0u, shared::RNG_STREAM_TEST, 3u);
     for (int s = 0; s < kSamples; ++s) {
       float pmf = 0.0f;
-      const uint32_t tri = shared::lt_sample(x, shared::rng_to_float(shared::rng_next4(rng).x), pmf);
+      const uint32_t tri = shared::lt_sample(x, r, shared::rng_to_float(shared::rng_next4(rng).x), pmf);
       observed[pmf > 0.0f ? index.at(tri) : none] += 1.0;
     }
     for (double& e : expected) e *= kSamples;

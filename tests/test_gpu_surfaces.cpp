@@ -129,12 +129,14 @@ TEST_F(GpuSurfaceTest, ASceneWithoutSurfacesCompilesNoTraversal) {
 }
 
 // The light tree (shared/light_tree.h, built by buildLightTree) over random emitters of every
-// orientation and size: at random shading points the probabilities of all emitters (lt_pmf, from
-// their trails) sum to at most 1, every emitter that faces
-// the point (at a corner or its centroid) has a nonzero probability (the importance bound is
+// orientation and size: at random shading points, in a medium (no receiver normal) and on a
+// surface (a random receiver normal), the probabilities of all emitters (lt_pmf, from their trails)
+// sum to at most 1, every emitter that faces the point and (on a surface) lies in front of its
+// normal — at a corner or its centroid — has a nonzero probability (the importance bound is
 // conservative: a zero would be a bias), and the descent (lt_sample) returns the probability
-// lt_pmf gives its triangle. (CityEmitters.LightTree... checks the descent's frequencies.) Also for one emitter,
-// and for many emitters on one spot (a degenerate split).
+// lt_pmf gives its triangle. (CityEmitters.LightTree... checks the descent's frequencies.) Also for
+// one emitter, and for many emitters on one spot (a degenerate split). The receiver bound must
+// also prune: on a surface, an emitter well behind it and far from it has probability 0.
 TEST(LightTree, ProbabilitiesSumToOneAndReachEveryEmitterThatFacesThePoint) {
   std::mt19937 gen(7);
   std::uniform_real_distribution<float> u01(0.0f, 1.0f);
@@ -151,30 +153,46 @@ TEST(LightTree, ProbabilitiesSumToOneAndReachEveryEmitterThatFacesThePoint) {
       ASSERT_EQ(tree.nodes.size(), size_t(2 * n - 1));
       EXPECT_LE(tree.depth, int(std::ceil(std::log2(double(n))))) << n;
       test::ltTestNodes = &tree.nodes;
-      for (int k = 0; k < 200; ++k) {
+      for (int k = 0; k < 400; ++k) {
         const glm::vec3 x = point(6.0f);
+        // Every other point on a surface: a receiver normal, light only from its side.
+        const glm::vec3 r = k % 2 == 0 ? glm::vec3(0.0f) : glm::normalize(point(1.0f) + glm::vec3(1e-3f));
+        const bool onSurface = k % 2 == 1;
         double sum = 0.0;
-        bool anyFaces = false;
         for (int i = 0; i < n; ++i) {
-          const float p = shared::lt_pmf(x, tree.trails[i]);
+          const float p = shared::lt_pmf(x, r, tree.trails[i]);
           sum += p;
           const glm::vec3 nrm = glm::cross(e[i].v1 - e[i].v0, e[i].v2 - e[i].v0);
           const glm::vec3 c = (e[i].v0 + e[i].v1 + e[i].v2) / 3.0f;
-          bool faces = false;
-          for (const glm::vec3 q : {e[i].v0, e[i].v1, e[i].v2, c}) faces = faces || glm::dot(nrm, x - q) > 1e-6f * glm::length(nrm) * glm::length(x - q);
-          anyFaces = anyFaces || faces;
-          if (faces) EXPECT_GT(p, 0.0f) << "emitter " << i << " of " << n << " faces the point but cannot be picked";
+          bool reaches = false;
+          bool behind = true;
+          for (const glm::vec3 q : {e[i].v0, e[i].v1, e[i].v2, c}) {
+            const bool faces = glm::dot(nrm, x - q) > 1e-6f * glm::length(nrm) * glm::length(x - q);
+            const bool inFront = !onSurface || glm::dot(r, q - x) > 1e-6f * glm::length(q - x);
+            reaches = reaches || (faces && inFront);
+            behind = behind && onSurface && glm::dot(r, q - x) < -0.3f * glm::length(q - x);
+          }
+          if (reaches) EXPECT_GT(p, 0.0f) << "emitter " << i << " of " << n << " lights the point but cannot be picked";
+          // A triangle is convex: all its corners well behind the receiver, so is all of it; the
+          // leaf's bound (the triangle's own box) must then give 0 unless x is inside its sphere.
+          const glm::vec3 lo = glm::min(e[i].v0, glm::min(e[i].v1, e[i].v2));
+          const glm::vec3 hi = glm::max(e[i].v0, glm::max(e[i].v1, e[i].v2));
+          const float radius = 0.5f * glm::length(hi - lo);
+          const bool farFromBox = glm::length(x - 0.5f * (lo + hi)) > 20.0f * radius;
+          // (A tree of one emitter has no choice to make: its pmf is 1, and a light sample that
+          // cannot light x is merely wasted.)
+          if (behind && farFromBox && n > 1) EXPECT_EQ(p, 0.0f) << "emitter " << i << " of " << n << " lies behind the receiver";
         }
         // Below 1 where the descent can reach a node none of whose emitters faces x (it then
         // returns no sample: nothing was lost that could light x).
         EXPECT_LE(sum, 1.0 + 1e-4) << n;
         const float u = u01(gen);
         float pmf = 0.0f;
-        const uint32_t tri = shared::lt_sample(x, u, pmf);
+        const uint32_t tri = shared::lt_sample(x, r, u, pmf);
         if (!(pmf > 0.0f)) continue;
         const auto it = std::find_if(e.begin(), e.end(), [&](const LightTreeEmitter& m) { return m.triangle == tri; });
         ASSERT_NE(it, e.end());
-        EXPECT_NEAR(pmf, shared::lt_pmf(x, tree.trails[size_t(it - e.begin())]), 1e-5f * pmf);
+        EXPECT_NEAR(pmf, shared::lt_pmf(x, r, tree.trails[size_t(it - e.begin())]), 1e-5f * pmf);
       }
     }
   }

@@ -77,6 +77,16 @@ vec3 vtx_local(PathVertex v, vec3 w) {
 bool vtx_reflects(PathVertex v, vec3 w) { return dot(v.n, w) * dot(v.n, v.rayDir) < 0.0f; }
 #endif
 
+#ifdef PLUME_HAS_EMITTERS
+// The vertex's receiver normal for the light tree (shared/light_tree.h): on a surface its
+// geometric normal on the side the path arrived from, the only side light reaches it from; 0 in
+// a medium (the phase function takes light from every direction).
+vec3 vtx_receiver(PathVertex v) {
+  if (v.kind == VERTEX_SURFACE) return surf_receiver(v.prim, -v.rayDir);
+  return vec3(0.0f);
+}
+#endif
+
 // Light arriving from w scattered along -rayDir: the phase function, or f(wo, w) |cos| at the
 // shading normal (0 across the geometric normal).
 vec3 vtx_at_scatter(PathVertex v, vec3 w) {

@@ -85,7 +85,8 @@ vec3 pt_direct(PathVertex v, inout RngState rng) {
   uvec4 h = rng_next4(rng);
   uint prim;
   vec2 b;
-  float pdfArea = surf_sample_emitter_at(v.x, vec3(rng_to_float(h.x), rng_to_float(h.y), rng_to_float(h.z)), prim, b);
+  vec3 receiver = vtx_receiver(v);
+  float pdfArea = surf_sample_emitter_at(v.x, receiver, vec3(rng_to_float(h.x), rng_to_float(h.y), rng_to_float(h.z)), prim, b);
   vec3 p = surf_triangle_point(prim, b);
   vec3 o = vtx_at_origin(v, p - v.x);
   vec3 toL = p - o;
@@ -96,8 +97,9 @@ vec3 pt_direct(PathVertex v, inout RngState rng) {
   if (pdfArea > 0.0f && dist > 0.0f && cosLight > 0.0f && any(greaterThan(scatter, vec3(0.0f)))) {
     float g = dist * dist / cosLight;  // area to solid angle at the vertex
     // The MIS weight with the light tree's density at the ray's origin, as pt_extend sees it
-    // when the vertex's own sampling hits the emitter (the same point for a medium vertex).
-    float pdfMis = (v.kind == VERTEX_MEDIUM ? pdfArea : surf_emitter_pdf_at(prim, o)) * g;
+    // when the vertex's own sampling hits the emitter (the same point for a medium vertex; the
+    // same receiver normal, as w leaves on the side the path arrived from).
+    float pdfMis = (v.kind == VERTEX_MEDIUM ? pdfArea : surf_emitter_pdf_at(prim, o, receiver)) * g;
     // Stop short of the emitter's own triangle.
     float tr = pt_shadow(v, w, dist - surf_offset_length(p), rng);
     sum += surf_emission(prim) * scatter * (tr * pt_power_heuristic(pdfMis, vtx_at_pdf(v, w)) / (pdfArea * g));
@@ -182,7 +184,10 @@ bool pt_extend(uint slot, bool camera) {
   bool vertex = path_has_vertex(seg);
   if (vertex) {
 #ifdef PLUME_HAS_EMITTERS
-    vec3 origin = p.origin;  // the ray's, before it moves to the vertex
+    // The ray's origin before it moves to the vertex, and the receiver normal there (the previous
+    // vertex's triangle: its normal on the ray's side; 0 after a medium vertex).
+    vec3 origin = p.origin;
+    vec3 receiver = p.prim != PT_MEDIUM_VERTEX ? surf_receiver(p.prim, p.dir) : vec3(0.0f);
 #endif
     PathVertex v = path_vertex(seg, p.origin, p.dir, p.beta);
     p.prim = PT_MEDIUM_VERTEX;
@@ -193,7 +198,7 @@ bool pt_extend(uint slot, bool camera) {
       // After a vertex, weighted against that vertex's emitter sampling (its area density turned
       // into solid angle at the vertex: distance² / cosine), the light tree's at the ray's origin.
       if (p.scatterings > 0u && any(greaterThan(le, vec3(0.0f)))) {
-        float pdfLight = surf_emitter_pdf_at(v.prim, origin) * seg.t * seg.t / abs(dot(v.n, p.dir));
+        float pdfLight = surf_emitter_pdf_at(v.prim, origin, receiver) * seg.t * seg.t / abs(dot(v.n, p.dir));
         le *= pt_power_heuristic(p.phasePdf, pdfLight);
       }
 #endif

@@ -81,10 +81,10 @@ PtPath pt_load(uint slot, const bool atVertex) {
   p.prim = PT_MEDIUM_VERTEX;
   p.shading = vec3(0.0f);
 #ifdef PLUME_HAS_SURFACES
-  if (atVertex) {
-    p.prim = t3.w;
-    p.shading = pt_xyz(pt_texel(slot, 4u));
-  }
+  // Extension reads the triangle of the vertex its ray leaves (emitter hits' MIS), shading that
+  // of the vertex it waits at.
+  p.prim = t3.w;
+  if (atVertex) p.shading = pt_xyz(pt_texel(slot, 4u));
 #endif
   p.pad = 0u;
   return p;

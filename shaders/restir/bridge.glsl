@@ -73,7 +73,7 @@ float rs_sample_light(PathVertex vx, vec3 u, inout RngState rng, out uint light,
 #ifdef PLUME_HAS_EMITTERS
   uvec4 e = rng_next4(rng);
   if (light == frame.lightCount) {
-    return pdf * surf_sample_emitter_at(vx.x, vec3(rng_to_float(e.x), rng_to_float(e.y), rng_to_float(e.z)), prim, ls);
+    return pdf * surf_sample_emitter_at(vx.x, vtx_receiver(vx), vec3(rng_to_float(e.x), rng_to_float(e.y), rng_to_float(e.z)), prim, ls);
   }
   GpuLight l = light_at(min(light, max(frame.lightCount, 1u) - 1u));  // (in range on every lane)
 #else
@@ -117,18 +117,20 @@ float rs_emitter_weight(float pdfThis, float pdfOther) {
 }
 
 // The light samples' solid-angle density at the ray origin o (the vertex, pushed off a surface
-// towards the light: the point both ways of reaching the emitter agree on).
-float rs_emitter_light_pdf(uint prim, vec3 o, float dist, float cosLight) {
-  return lightChoice[frame.lightCount].probability * surf_emitter_pdf_at(prim, o) * dist * dist / cosLight;
+// towards the light: the point both ways of reaching the emitter agree on) with the vertex's
+// receiver normal n (vtx_receiver; both ways agree on it too where the emitter lies on the side
+// the path arrived from, the only side a surface vertex takes light from).
+float rs_emitter_light_pdf(uint prim, vec3 o, vec3 n, float dist, float cosLight) {
+  return lightChoice[frame.lightCount].probability * surf_emitter_pdf_at(prim, o, n) * dist * dist / cosLight;
 }
 
 // The emission of a hit on triangle prim at distance t along w from the ray origin o of a vertex
-// whose direction sampling has density pdfDir there (vtx_at_pdf), with its MIS weight: the
-// direction-sampling part of an emitter's light.
-vec3 rs_emitter_hit(float pdfDir, uint prim, vec3 o, vec3 w, float t) {
+// (receiver normal `receiver`) whose direction sampling has density pdfDir there (vtx_at_pdf),
+// with its MIS weight: the direction-sampling part of an emitter's light.
+vec3 rs_emitter_hit(float pdfDir, uint prim, vec3 o, vec3 receiver, vec3 w, float t) {
   vec3 n = surf_normal(prim);
   vec3 Le = surf_emitted(prim, n, w);
-  float pl = rs_emitter_light_pdf(prim, o, t, abs(dot(n, w)));
+  float pl = rs_emitter_light_pdf(prim, o, receiver, t, abs(dot(n, w)));
   return Le * rs_emitter_weight(pdfDir, pl);
 }
 #endif
@@ -159,7 +161,7 @@ bool rs_light_connect(PathVertex vx, uint light, vec2 ls, uint prim, bool withMi
     c.value = vec3(0.0f);
     if (!(dist > 0.0f) || !(cosLight > 0.0f)) return false;
     vec3 scatter = vtx_at_scatter(vx, c.w);
-    float mis = withMis ? rs_emitter_weight(rs_emitter_light_pdf(prim, c.o, dist, cosLight), vtx_at_pdf(vx, c.w)) : 1.0f;
+    float mis = withMis ? rs_emitter_weight(rs_emitter_light_pdf(prim, c.o, vtx_receiver(vx), dist, cosLight), vtx_at_pdf(vx, c.w)) : 1.0f;
     c.value = surf_emission(prim) * scatter * (mis * cosLight / (dist * dist));
     return true;
   }
@@ -447,7 +449,7 @@ vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool shading, i
     if (kind == VERTEX_SURFACE) {
 #ifdef PLUME_HAS_EMITTERS
       if (h.light == RS_LIGHT_EMITTER_HIT && i == n) {
-        return f * tr * rs_emitter_hit(vtx_at_pdf(prev, w), hit.prim, o, w, t);  // i >= 2
+        return f * tr * rs_emitter_hit(vtx_at_pdf(prev, w), hit.prim, o, vtx_receiver(prev), w, t);  // i >= 2
       }
 #endif
       vec3 ng = surf_normal(hit.prim);

@@ -365,7 +365,7 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
         // The candidate ending with the emitter this direction hits (its direction-sampling
         // part, rs_emitter_hit); the camera ray's hit is the lamp reservoir's (rs_lamp_reservoir).
         if (j >= 2u) {
-          float ph = rs_luminance(f * rs_emitter_hit(vtx_at_pdf(prev, w), hit.prim, o, w, t));
+          float ph = rs_luminance(f * rs_emitter_hit(vtx_at_pdf(prev, w), hit.prim, o, vtx_receiver(prev), w, t));
           if (rs_update(r, invM * ph / pdf, ph, 0.0f, rng_float(rng))) {
             head = rs_candidate_head(uv, t1, j, kinds, RS_LIGHT_EMITTER_HIT, vec2(0.0f), 0u);
             keep = j;

@@ -43,15 +43,19 @@ struct RsTail {
   vec3 beta;
   float pdfDir;  // with surfaces: the density of w at the vertex that sampled it (vtx_at_pdf)
   vec3 L;       // the tail's radiance so far
+  uint from;    // with surfaces: the triangle of the vertex that drew w (RS_TAIL_NO_SURFACE: none)
   vec3 shaded;  // final shading's other terms (rs_shade): the pixel's sample is shaded + L
 };
+
+const uint RS_TAIL_NO_SURFACE = 0xffffffffu;
 
 // The walk's state: rs_state(rs_state_slot(pixel) + i), i < RS_STATE_SLOTS.
 RsTail rs_tail_load(uint pixelIndex) {
   uint s = rs_state_slot(pixelIndex);
   vec4 a = rs_state(s), b = rs_state(s + 1u);
   vec4 c = rs_state(s + 2u);
-  return RsTail(a.xyz, floatBitsToUint(a.w), b.xyz, floatBitsToUint(b.w), c.xyz, c.w, rs_state(s + 3u).xyz,
+  vec4 d = rs_state(s + 3u);
+  return RsTail(a.xyz, floatBitsToUint(a.w), b.xyz, floatBitsToUint(b.w), c.xyz, c.w, d.xyz, floatBitsToUint(d.w),
                 rs_state(s + 4u).xyz);
 }
 
@@ -60,13 +64,13 @@ void rs_tail_store(uint pixelIndex, RsTail s) {
   rs_set_state(i, vec4(s.x, uintBitsToFloat(s.j)));
   rs_set_state(i + 1u, vec4(s.w, uintBitsToFloat(s.rngCounter)));
   rs_set_state(i + 2u, vec4(s.beta, s.pdfDir));
-  rs_set_state(i + 3u, vec4(s.L, 0.0f));
+  rs_set_state(i + 3u, vec4(s.L, uintBitsToFloat(s.from)));
   rs_set_state(i + 4u, vec4(s.shaded, 0.0f));
 }
 
 RsTail rs_tail_start(RsDomain D, vec3 shaded, inout RngState rng) {
   vec3 w = rs_domain_dir(D, rng_float2(rng));  // its own sub-pixel position: pdf 1 on the pixel
-  return RsTail(D.origin, 1u, w, rng.counter, vec3(1.0f), 0.0f, vec3(0.0f), shaded);
+  return RsTail(D.origin, 1u, w, rng.counter, vec3(1.0f), 0.0f, vec3(0.0f), RS_TAIL_NO_SURFACE, shaded);
 }
 
 // Segment s.j of the walk and what its vertex adds; false when the walk ends there. The segment
@@ -89,7 +93,10 @@ bool rs_tail_segment(inout RsTail s, inout RngState rng) {
 #ifdef PLUME_HAS_EMITTERS
   // An emitter hit by the direction sampled at vertex j - 1 (its MIS part; the reservoirs hold
   // those of segments up to rs_emission_vertices).
-  if (path_hits_surface(seg) && j > emitting) s.L += s.beta * rs_emitter_hit(s.pdfDir, seg.hit.prim, s.x, s.w, seg.t);
+  if (path_hits_surface(seg) && j > emitting) {
+    vec3 receiver = s.from != RS_TAIL_NO_SURFACE ? surf_receiver(s.from, s.w) : vec3(0.0f);
+    s.L += s.beta * rs_emitter_hit(s.pdfDir, seg.hit.prim, s.x, receiver, s.w, seg.t);
+  }
 #endif
   if (!path_has_vertex(seg)) return false;
 #ifdef RS_ENDS_IN_EMISSION
@@ -111,6 +118,7 @@ bool rs_tail_segment(inout RsTail s, inout RngState rng) {
   float pdf;
   if (!path_scatter(vx, rng_float2(rng), s.beta, s.x, s.w, pdf)) return false;
   s.pdfDir = vtx_at_pdf(vx, s.w);  // evaluated as the reservoirs' emitter hits evaluate it
+  s.from = vx.kind == VERTEX_SURFACE ? vx.prim : RS_TAIL_NO_SURFACE;
 #else
   // The phase's sample as such (vtx_at_sample normalises it once more, and evaluates a pdf the
   // walk has no use for without emitters).

@@ -14,6 +14,18 @@
 // the direction q -> x is within theta_b (the bounding sphere's half-angle seen from x) of the
 // direction centre -> x, and every front normal within theta_o of the axis, so no triangle faces
 // x where theta_w - theta_o - theta_b >= 90 degrees.
+//
+// A shading point on a surface also has a receiver: its geometric normal n turned to the side light
+// arrives from (every BSDF reflects only; integrator/vertex.glsl vtx_reflects), which no light
+// behind it reaches. The same sphere bounds the directions x -> q, so with theta_i the angle
+// between n and x -> centre, no point of the box lies in front of n where theta_i - theta_b >= 90
+// degrees, and the importance is 0 there; elsewhere it carries the largest cosine at the receiver,
+// cos(max(0, theta_i - theta_b)) (pbrt-v4's BVHLightSampler; its absolute value there, for BSDFs
+// that transmit). A point in a medium passes n = 0: no receiver bound. The bound is computed with
+// a slack of LT_RECEIVER_SLACK in the cosine (the rays leave from x pushed off the surface, and the
+// bound must hold there too), and a node within the slack keeps LT_RECEIVER_FLOOR of its weight.
+// The sampling and every MIS weight that evaluates these probabilities pass the same receiver for
+// a vertex (its normal turned against the arriving ray, or towards the ray that leaves it).
 #ifndef PLUME_SHARED_LIGHT_TREE_H
 #define PLUME_SHARED_LIGHT_TREE_H
 
@@ -33,8 +45,12 @@ struct GpuLightNode {
   uint child;     // first child, or LT_LEAF | triangle (input index)
 };
 
-// The node's importance for a shading point x (see above; 0 only where nothing below faces x).
-PLUME_FN float lt_importance(GpuLightNode nd, vec3 x) {
+const float LT_RECEIVER_SLACK = 0.01f;
+const float LT_RECEIVER_FLOOR = 0.01f;
+
+// The node's importance for a shading point x with receiver normal n (0: none; see above): 0 only
+// where nothing below faces x, or lies in front of n.
+PLUME_FN float lt_importance(GpuLightNode nd, vec3 x, vec3 n) {
   if (!(nd.power > 0.0f)) return 0.0f;
   vec3 c = 0.5f * (nd.boxMin + nd.boxMax);
   vec3 d = x - c;
@@ -60,6 +76,14 @@ PLUME_FN float lt_importance(GpuLightNode nd, vec3 x) {
   float cosP = 1.0f;
   if (cosWO < cosB) cosP = cosWO * cosB + sinWO * sinB;
   if (!(cosP > 0.0f)) return 0.0f;
+  if (dot(n, n) > 0.0f) {
+    // cos(max(0, theta_i - theta_b)), theta_i between n and x -> centre (= -d)
+    float cosI = -dot(n, d) / dist;
+    float sinI = sqrt(max(0.0f, 1.0f - cosI * cosI));
+    float cosIB = cosI >= cosB ? 1.0f : cosI * cosB + sinI * sinB;
+    if (!(cosIB > -LT_RECEIVER_SLACK)) return 0.0f;
+    cosP *= max(cosIB, LT_RECEIVER_FLOOR);
+  }
   return nd.power * cosP / dist2;
 }
 
@@ -87,15 +111,16 @@ static_assert(offsetof(plume::shared::GpuLightNode, axis) == 32, "GpuLightNode l
 
 PLUME_NS_BEGIN
 
-// The triangle (input index) that the descent from the root picks for x with u in [0, 1) (one
-// number, rescaled at each level), and its probability in pmf (0: no triangle can light x).
-PLUME_FN uint lt_sample(vec3 x, float u, OUT(float) pmf) {
+// The triangle (input index) that the descent from the root picks for x (receiver normal n, 0:
+// none) with u in [0, 1) (one number, rescaled at each level), and its probability in pmf (0: no
+// triangle can light x).
+PLUME_FN uint lt_sample(vec3 x, vec3 n, float u, OUT(float) pmf) {
   pmf = 1.0f;
   GpuLightNode nd = LT_NODE(0u);
   while ((nd.child & LT_LEAF) == 0u) {
     GpuLightNode a = LT_NODE(nd.child);
     GpuLightNode b = LT_NODE(nd.child + 1u);
-    float p0 = lt_first_child_probability(lt_importance(a, x), lt_importance(b, x));
+    float p0 = lt_first_child_probability(lt_importance(a, x, n), lt_importance(b, x, n));
     if (p0 < 0.0f) {
       pmf = 0.0f;
       return 0u;
@@ -114,18 +139,19 @@ PLUME_FN uint lt_sample(vec3 x, float u, OUT(float) pmf) {
   return nd.child & ~LT_LEAF;
 }
 
-// The probability with which lt_sample picks the triangle whose trail is `trail` at x: bit k is
+// The probability with which lt_sample picks the triangle whose trail is `trail` at x (receiver
+// normal n): bit k is
 // the turn at depth k (1: the second child), and a 1 above the last turn; 0: not in the tree.
 // Two nodes read per level, the children, as lt_sample reads them (the next pair's index is the
 // chosen child's `child`).
-PLUME_FN float lt_pmf(vec3 x, uint trail) {
+PLUME_FN float lt_pmf(vec3 x, vec3 n, uint trail) {
   if (trail == 0u) return 0.0f;
   float pmf = 1.0f;
   uint child = LT_NODE(0u).child;
   while (trail > 1u) {
     GpuLightNode a = LT_NODE(child);
     GpuLightNode b = LT_NODE(child + 1u);
-    float p0 = lt_first_child_probability(lt_importance(a, x), lt_importance(b, x));
+    float p0 = lt_first_child_probability(lt_importance(a, x, n), lt_importance(b, x, n));
     if (p0 < 0.0f) return 0.0f;
     bool second = (trail & 1u) != 0u;
     pmf *= second ? 1.0f - p0 : p0;

@@ -126,21 +126,29 @@ vec3 surf_emission(uint prim) { return surf_material_emission(surf_surface(prim)
 float surf_emitter_inv_area(uint prim) { return uintBitsToFloat(surf_triangle_texel(prim, 1u).w); }
 uint surf_light_trail(uint prim) { return surf_triangle_texel(prim, 3u).w; }
 
-// A point on the emissive triangles for the shading point x (u in [0,1)³): a triangle from the
-// light tree (u.x), a uniform point in it (u.yz) as barycentrics. Returns its area density
-// (0: no emitter can light x).
-float surf_sample_emitter_at(vec3 x, vec3 u, out uint prim, out vec2 barycentrics) {
+// The receiver normal of a surface vertex on triangle prim for the light tree (shared/light_tree.h):
+// its geometric normal turned towards w, a direction on the side light arrives from (the ray that
+// leaves the vertex, or minus the one that arrived).
+vec3 surf_receiver(uint prim, vec3 w) {
+  vec3 n = surf_normal(prim);
+  return dot(n, w) < 0.0f ? -n : n;
+}
+
+// A point on the emissive triangles for the shading point x with receiver normal n (0: a point
+// in a medium; surf_receiver) from u in [0,1)³: a triangle from the light tree (u.x), a uniform
+// point in it (u.yz) as barycentrics. Returns its area density (0: no emitter can light x).
+float surf_sample_emitter_at(vec3 x, vec3 n, vec3 u, out uint prim, out vec2 barycentrics) {
   float pmf;
-  prim = lt_sample(x, u.x, pmf);
+  prim = lt_sample(x, n, u.x, pmf);
   barycentrics = surf_uniform_barycentrics(u.yz);
   return pmf > 0.0f ? pmf * surf_emitter_inv_area(prim) : 0.0f;
 }
 
-// The area density with which surf_sample_emitter_at(x) picks a point of triangle prim (0: it is
-// dark, or cannot light x).
-float surf_emitter_pdf_at(uint prim, vec3 x) {
+// The area density with which surf_sample_emitter_at(x, n) picks a point of triangle prim (0: it
+// is dark, or cannot light x).
+float surf_emitter_pdf_at(uint prim, vec3 x, vec3 n) {
   float invArea = surf_emitter_inv_area(prim);
-  return invArea > 0.0f ? lt_pmf(x, surf_light_trail(prim)) * invArea : 0.0f;
+  return invArea > 0.0f ? lt_pmf(x, n, surf_light_trail(prim)) * invArea : 0.0f;
 }
 #endif
 

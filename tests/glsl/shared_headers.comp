@@ -174,7 +174,7 @@ void main() {
   node.axis = vec3(0.0f, 0.0f, 1.0f);
   node.cosCone = 0.5f;
   node.child = LT_LEAF;
-  t += lt_importance(node, wo + vec3(3.0f)) + lt_first_child_probability(1.0f, 2.0f) + material.bsdf.alpha;
+  t += lt_importance(node, wo + vec3(3.0f), wo) + lt_first_child_probability(1.0f, 2.0f) + material.bsdf.alpha;
   values[i] = vec4(s + wo, t + m + (picked ? 1.0f : 0.0f) + (dropped ? 2.0f : 0.0f) +
                    (rs_is_finite(back.W) ? back.W : 0.0f));
 }
