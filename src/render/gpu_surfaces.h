@@ -18,8 +18,10 @@ namespace plume {
 
 // The light tree over the emissive triangles (shaders/shared/light_tree.h): nodes[0] is the root,
 // the children of an inner node are adjacent, and trails[i] is emitter i's path from the root
-// (lt_pmf's encoding). Built by splitting at the median centroid along the longest axis of the
-// centroids' box, so its depth is ceil(log2 n) (at most 30: n < 2^30).
+// (lt_pmf's encoding). Built top down, each node split at the plane of least SAOH cost (power x
+// orientation measure x box area of the two children, pbrt-v4's BVHLightSampler), or at the median
+// centroid along the longest axis where no plane separates the centroids or a child would be too
+// large for the trails' bits: its depth is at most 30 (n < 2^30).
 struct LightTreeEmitter {
   glm::vec3 v0, v1, v2;
   double power;       // area times mean(Le)
