@@ -85,10 +85,15 @@ vec3 pt_direct(PathVertex v, inout RngState rng) {
   uvec4 h = rng_next4(rng);
   uint prim;
   vec2 b;
+  // The light ray's origin: the vertex, pushed off a surface to the side the path arrived from,
+  // the only side it takes light from (a direction to the other side has scatter 0), so it is
+  // known before the sample. The tree is descended there, so the sample's density is also the
+  // one pt_extend's MIS evaluates at the same origin when the vertex's own sampling hits the
+  // emitter: one descent per vertex instead of a second for the MIS weight.
+  vec3 o = vtx_at_origin(v, -v.rayDir);
   vec3 receiver = vtx_receiver(v);
-  float pdfArea = surf_sample_emitter_at(v.x, receiver, vec3(rng_to_float(h.x), rng_to_float(h.y), rng_to_float(h.z)), prim, b);
+  float pdfArea = surf_sample_emitter_at(o, receiver, vec3(rng_to_float(h.x), rng_to_float(h.y), rng_to_float(h.z)), prim, b);
   vec3 p = surf_triangle_point(prim, b);
-  vec3 o = vtx_at_origin(v, p - v.x);
   vec3 toL = p - o;
   float dist = length(toL);
   vec3 w = toL / dist;
@@ -96,10 +101,10 @@ vec3 pt_direct(PathVertex v, inout RngState rng) {
   vec3 scatter = vtx_at_scatter(v, w);
   if (pdfArea > 0.0f && dist > 0.0f && cosLight > 0.0f && any(greaterThan(scatter, vec3(0.0f)))) {
     float g = dist * dist / cosLight;  // area to solid angle at the vertex
-    // The MIS weight with the light tree's density at the ray's origin, as pt_extend sees it
-    // when the vertex's own sampling hits the emitter (the same point for a medium vertex; the
-    // same receiver normal, as w leaves on the side the path arrived from).
-    float pdfMis = (v.kind == VERTEX_MEDIUM ? pdfArea : surf_emitter_pdf_at(prim, o, receiver)) * g;
+    // The MIS weight: the sample's own density, which pt_extend evaluates at the same origin with
+    // the same receiver normal when the vertex's sampling hits the emitter (w leaves on the side
+    // the path arrived from: scatter is 0 otherwise).
+    float pdfMis = pdfArea * g;
     // Stop short of the emitter's own triangle.
     float tr = pt_shadow(v, w, dist - surf_offset_length(p), rng);
     sum += surf_emission(prim) * scatter * (tr * pt_power_heuristic(pdfMis, vtx_at_pdf(v, w)) / (pdfArea * g));
