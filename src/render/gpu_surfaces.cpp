@@ -41,8 +41,8 @@ double orientationMeasure(double cosO) {
 }
 
 // What the surface area orientation heuristic (SAOH) needs of a set of emitters: their triangles'
-// box, summed power and normals, and the cones of the buckets they came from (to bound the
-// union's cone without another pass over the emitters).
+// box, summed power and normals, and their count (a bucket's cone is kept beside it, for
+// unionCone, so that a split's cone needs no other pass over the emitters).
 struct SplitBounds {
   glm::dvec3 lo{INFINITY}, hi{-INFINITY};
   glm::dvec3 normalSum{0.0};
