@@ -139,6 +139,7 @@ TEST_F(GpuSurfaceTest, ASceneWithoutSurfacesCompilesNoTraversal) {
 // also prune: on a surface, an emitter well behind it and far from it has probability 0.
 TEST(LightTree, ProbabilitiesSumToOneAndReachEveryEmitterThatFacesThePoint) {
   std::mt19937 gen(7);
+  int prunedChecks = 0;  // emitters checked to be pruned by the receiver bound
   std::uniform_real_distribution<float> u01(0.0f, 1.0f);
   auto point = [&](float r) { return r * glm::vec3(2.0f * u01(gen) - 1.0f, 2.0f * u01(gen) - 1.0f, 2.0f * u01(gen) - 1.0f); };
   for (const int n : {1, 2, 3, 1000, 4096}) {
@@ -189,6 +190,7 @@ TEST(LightTree, ProbabilitiesSumToOneAndReachEveryEmitterThatFacesThePoint) {
           // cannot light x is merely wasted.)
           if (behind && farFromBox && n > 1) {
             EXPECT_EQ(p, 0.0f) << "emitter " << i << " of " << n << " lies behind the receiver";
+            ++prunedChecks;
           }
         }
         // Below 1 where the descent can reach a node none of whose emitters faces x (it then
@@ -204,4 +206,6 @@ TEST(LightTree, ProbabilitiesSumToOneAndReachEveryEmitterThatFacesThePoint) {
       }
     }
   }
+  std::printf("emitters checked to be pruned behind a receiver: %d\n", prunedChecks);
+  EXPECT_GT(prunedChecks, 100000);  // the pruning check is not vacuous
 }
