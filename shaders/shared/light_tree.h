@@ -15,6 +15,16 @@
 // direction centre -> x, and every front normal within theta_o of the axis, so no triangle faces
 // x where theta_w - theta_o - theta_b >= 90 degrees.
 //
+// How much a node weighs beside its sibling is an estimate only (any positive value where light
+// can arrive keeps the estimators unbiased), and the distance term decides it: the node's power
+// times the mean of 1 / d² over its bounding sphere as if its emitters filled it, seen from x
+// (exact for a uniform ball: 3/4 (2 + (1 - a²)/a ln|(1 + a)/(1 - a)|) / r² at a = D / r; 3 / r² at
+// its centre, where 1 / D² would be infinite). A node's sphere that holds x holds emitters near x,
+// and its sibling's are farther: on the bundled city's ground 0.04 under a street lamp the lamp's
+// triangle had probability 0.019 when the distance was clamped at the radius (the importance
+// P / r² inside the sphere) and its ancestors lost 5-45% to their siblings at every level
+// (notes/city.md "Session 35").
+//
 // A shading point on a surface also has a receiver: its geometric normal n turned to the side light
 // arrives from (every BSDF reflects only; integrator/vertex.glsl vtx_reflects), which no light
 // behind it reaches. The same sphere bounds the directions x -> q, so with theta_i the angle
@@ -57,7 +67,11 @@ PLUME_FN float lt_importance(GpuLightNode nd, vec3 x, vec3 n) {
   float dist2 = dot(d, d);
   vec3 diag = nd.boxMax - nd.boxMin;
   float r2 = 0.25f * dot(diag, diag);  // the bounding sphere's radius, squared
-  if (dist2 <= r2) return nd.power / max(r2, 1e-20f);  // x inside the sphere: no angular bound
+  // The falloff: the mean of 1 / d² over a ball of radius r whose centre is at distance D from
+  // x, 3 / r² at D = 0, 1.5 / r² at D = r, 1 / D² far off; approximated by 1 / max(D² - r²/3,
+  // r²/3), exact at those three and within 28% between (see above).
+  float meanInvD2 = 1.0f / max(max(dist2 - r2 / 3.0f, r2 / 3.0f), 1e-20f);
+  if (dist2 <= r2) return nd.power * meanInvD2;  // x inside the sphere: no angular bound
   float dist = sqrt(dist2);
   float cosW = dot(nd.axis, d) / dist;  // angle between the axis and centre -> x
   float sinW = sqrt(max(0.0f, 1.0f - cosW * cosW));
@@ -84,7 +98,7 @@ PLUME_FN float lt_importance(GpuLightNode nd, vec3 x, vec3 n) {
     if (!(cosIB > -LT_RECEIVER_SLACK)) return 0.0f;
     cosP *= max(cosIB, LT_RECEIVER_FLOOR);
   }
-  return nd.power * cosP / dist2;
+  return nd.power * cosP * meanInvD2;
 }
 
 // The probability of the first child (a, b: the children's importances); -1 where neither can
