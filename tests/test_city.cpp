@@ -159,7 +159,7 @@ TEST(CityGenerator, RefusesBadArguments) {
 // samples each against the probabilities lt_pmf gives every triangle and the rest, the chance of
 // no sample (chi-square, Šidák over 4). The tree is that many times better than a choice by power alone where a lamp is
 // near: the test prints the probability of the nearest lamp's two triangles under each scheme,
-// and requires the tree's to stay above 0.03 at the point under it.
+// and requires the tree's to stay above 0.07 at the point under it.
 // (With every inner node's first-child probability computed 10% high in lt_pmf only, by hand, it
 // fails.)
 TEST(CityEmitters, LightTreeSamplesThousandsOfEmittersAsItsProbabilitiesSay) {
@@ -218,9 +218,10 @@ TEST(CityEmitters, LightTreeSamplesThousandsOfEmittersAsItsProbabilitiesSay) {
       std::printf("under a street lamp: its triangle has probability %.3g by the tree, %.3g by power\n",
                   expected[i] / kSamples, lamp.power / total);
       EXPECT_GT(expected[i] / kSamples, 100.0 * lamp.power / total);
-      // The distance term's mean over a node's sphere (shared/light_tree.h): 0.040 (0.019 with the
-      // distance clamped at the radius, which halves the lamp's chance).
-      EXPECT_GT(expected[i] / kSamples, 0.03);
+      // The distance term's mean over a node's sphere (shared/light_tree.h) gave 0.040 (0.019 with
+      // the distance clamped at the radius); the descent's two-level steps, which weigh
+      // grandchildren, 0.088.
+      EXPECT_GT(expected[i] / kSamples, 0.07);
     }
   }
 }

@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <random>
 
 using namespace plume;
@@ -165,6 +166,70 @@ TEST(LightTree, DistanceTermIsTheMeanOfInverseSquareDistanceOverTheSphere) {
   const float in = shared::lt_importance(nd, (r * 0.9999f) * dir, glm::vec3(0.0f));
   const float out = shared::lt_importance(nd, (r * 1.0001f) * dir, glm::vec3(0.0f));
   EXPECT_NEAR(in / out, 1.0f, 1e-3f);
+}
+
+// The descent's steps (shared/light_tree.h lt_step): from a node, one of its grandchildren (a child
+// that is a leaf standing for itself) in proportion to its importance, two levels a step. An
+// independent walk over the whole tree with that rule gives every emitter's probability, which
+// lt_pmf must equal, for trees of 2 to 1000 random emitters (leaves at odd and even depths) at
+// random points in a medium and on surfaces. (The binary rule, one level a step, fails it, and so
+// does lt_pmf with the grandchildren's probabilities swapped within a pair.)
+TEST(LightTree, EachStepPicksAGrandchildByItsImportance) {
+  std::mt19937 gen(11);
+  std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+  auto point = [&](float r) { return r * glm::vec3(2.0f * u01(gen) - 1.0f, 2.0f * u01(gen) - 1.0f, 2.0f * u01(gen) - 1.0f); };
+  int compared = 0;
+  double worst = 0.0;  // the largest relative difference
+  for (const int n : {2, 3, 5, 6, 1000}) {
+    std::vector<LightTreeEmitter> e;
+    for (int i = 0; i < n; ++i) {
+      const glm::vec3 c = point(3.0f);
+      const float size = std::pow(10.0f, -2.0f + 1.5f * u01(gen));
+      e.push_back({c + point(size), c + point(size), c + point(size), std::pow(10.0, 2.0 * u01(gen)), uint32_t(i)});
+    }
+    const LightTree tree = buildLightTree(e);
+    test::ltTestNodes = &tree.nodes;
+    const auto& nodes = tree.nodes;
+    for (int k = 0; k < 50; ++k) {
+      const glm::vec3 x = point(4.0f);
+      const glm::vec3 r = k % 2 == 0 ? glm::vec3(0.0f) : glm::normalize(point(1.0f) + glm::vec3(1e-3f));
+      std::vector<double> want(size_t(n), 0.0);
+      // From node i with probability p: the candidates and their importances.
+      std::function<void(uint32_t, double)> walk = [&](uint32_t i, double p) {
+        const shared::GpuLightNode& nd = nodes[i];
+        if (nd.child & shared::LT_LEAF) {
+          want[nd.child & ~shared::LT_LEAF] = p;
+          return;
+        }
+        std::vector<uint32_t> cand;
+        for (const uint32_t c : {nd.child, nd.child + 1u}) {
+          if (nodes[c].child & shared::LT_LEAF) {
+            cand.push_back(c);
+          } else {
+            cand.push_back(nodes[c].child);
+            cand.push_back(nodes[c].child + 1u);
+          }
+        }
+        double total = 0.0;
+        for (const uint32_t c : cand) total += shared::lt_importance(nodes[c], x, r);
+        if (!(total > 0.0)) return;
+        for (const uint32_t c : cand) {
+          const double w = shared::lt_importance(nodes[c], x, r);
+          if (w > 0.0) walk(c, p * w / total);
+        }
+      };
+      walk(0u, 1.0);
+      for (int i = 0; i < n; ++i) {
+        // float arithmetic over up to ~10 steps, 1 - p where p is near 1 among them (1e-4 seen)
+        const double got = shared::lt_pmf(x, r, tree.trails[size_t(i)]);
+        EXPECT_NEAR(got, want[size_t(i)], 1e-3 * want[size_t(i)] + 1e-12) << "emitter " << i << " of " << n;
+        if (want[size_t(i)] > 0.0) worst = std::max(worst, std::abs(got / want[size_t(i)] - 1.0));
+        ++compared;
+      }
+    }
+  }
+  EXPECT_EQ(compared, 50 * (2 + 3 + 5 + 6 + 1000));
+  std::printf("largest relative difference from the walk: %.3g\n", worst);
 }
 
 // The light tree (shared/light_tree.h, built by buildLightTree) over random emitters of every

@@ -1,8 +1,8 @@
 // The light tree over the emissive triangles (render/gpu_surfaces.cpp builds it, surface/
 // surfaces.glsl samples it): a binary tree whose nodes bound their triangles' positions (a box),
 // front normals (a cone) and power, so that a shading point x picks a triangle by descending from
-// the root, choosing each child in proportion to an importance that falls off with distance and
-// vanishes where no triangle below can face x (Conty Estevez and Kulla 2018, "Importance Sampling
+// the root, two levels a step, choosing among a node's grandchildren in proportion to an
+// importance that falls off with distance and vanishes where no triangle below can face x (Conty Estevez and Kulla 2018, "Importance Sampling
 // of Many Lights with Adaptive Tree Splitting"; pbrt-v4's BVHLightSampler). Among thousands of
 // small lamps the ones near x and facing it get most samples, which a choice by power alone
 // cannot do (notes/city.md). Shared by C++ and GLSL: the tests descend the tree with this code.
@@ -125,52 +125,83 @@ static_assert(offsetof(plume::shared::GpuLightNode, axis) == 32, "GpuLightNode l
 
 PLUME_NS_BEGIN
 
+// The descent goes down two levels a step: from the pair of children at `child` it picks one of
+// their children (a child that is a leaf stands for itself), each in proportion to its
+// importance. A grandchild's importance sees its emitters from nearer than its parent's does (a
+// smaller sphere), so under a street lamp the lamp's side of the tree weighs more; and it costs as
+// many importances as two binary levels, in half the loop's iterations (notes/city.md "Session
+// 36"). The choice is made as two binary ones: the child by the sum of its pair, then the
+// grandchild within it, so the probabilities and the rescaled number are lt_first_child_probability's.
+// lt_step fills the four candidates' node indices and importances: slots x, y under the first
+// child, z, w under the second; a leaf child fills its first slot with itself and its second with
+// the same index and importance 0.
+PLUME_FN void lt_step(uint child, vec3 x, vec3 n, OUT(uvec4) node, OUT(vec4) w) {
+  uint ca = LT_NODE(child).child;
+  uint cb = LT_NODE(child + 1u).child;
+  bool la = (ca & LT_LEAF) != 0u;
+  bool lb = (cb & LT_LEAF) != 0u;
+  node = uvec4(la ? child : ca, la ? child : ca + 1u, lb ? child + 1u : cb, lb ? child + 1u : cb + 1u);
+  w = vec4(lt_importance(LT_NODE(node.x), x, n), la ? 0.0f : lt_importance(LT_NODE(node.y), x, n),
+           lt_importance(LT_NODE(node.z), x, n), lb ? 0.0f : lt_importance(LT_NODE(node.w), x, n));
+}
+
 // The triangle (input index) that the descent from the root picks for x (receiver normal n, 0:
-// none) with u in [0, 1) (one number, rescaled at each level), and its probability in pmf (0: no
+// none) with u in [0, 1) (one number, rescaled at each choice), and its probability in pmf (0: no
 // triangle can light x).
 PLUME_FN uint lt_sample(vec3 x, vec3 n, float u, OUT(float) pmf) {
   pmf = 1.0f;
-  GpuLightNode nd = LT_NODE(0u);
-  while ((nd.child & LT_LEAF) == 0u) {
-    GpuLightNode a = LT_NODE(nd.child);
-    GpuLightNode b = LT_NODE(nd.child + 1u);
-    float p0 = lt_first_child_probability(lt_importance(a, x, n), lt_importance(b, x, n));
+  uint child = LT_NODE(0u).child;
+  while ((child & LT_LEAF) == 0u) {
+    uvec4 node;
+    vec4 w;
+    lt_step(child, x, n, node, w);
+    float p0 = lt_first_child_probability(w.x + w.y, w.z + w.w);
     if (p0 < 0.0f) {
       pmf = 0.0f;
       return 0u;
     }
-    if (u < p0) {
-      u = u / p0;
-      pmf *= p0;
-      nd = a;
-    } else {
-      u = (u - p0) / (1.0f - p0);
-      pmf *= 1.0f - p0;
-      nd = b;
-    }
+    bool second = u >= p0;
+    u = second ? (u - p0) / (1.0f - p0) : u / p0;
+    pmf *= second ? 1.0f - p0 : p0;
     u = min(u, 0.99999994f);
+    // within the chosen pair (its sum is positive: a pair of sum 0 has probability 0)
+    vec2 pw = second ? vec2(w.z, w.w) : vec2(w.x, w.y);
+    uvec2 pn = second ? uvec2(node.z, node.w) : uvec2(node.x, node.y);
+    float p1 = pw.x / (pw.x + pw.y);
+    bool second1 = u >= p1;
+    u = second1 ? (u - p1) / (1.0f - p1) : u / p1;
+    pmf *= second1 ? 1.0f - p1 : p1;
+    u = min(u, 0.99999994f);
+    child = LT_NODE(second1 ? pn.y : pn.x).child;
   }
-  return nd.child & ~LT_LEAF;
+  return child & ~LT_LEAF;
 }
 
 // The probability with which lt_sample picks the triangle whose trail is `trail` at x (receiver
-// normal n): bit k is
-// the turn at depth k (1: the second child), and a 1 above the last turn; 0: not in the tree.
-// Two nodes read per level, the children, as lt_sample reads them (the next pair's index is the
-// chosen child's `child`).
+// normal n): bit k is the turn at depth k (1: the second child), and a 1 above the last turn; 0:
+// not in the tree. The same steps as lt_sample, two turns each (one where the child is a leaf).
 PLUME_FN float lt_pmf(vec3 x, vec3 n, uint trail) {
   if (trail == 0u) return 0.0f;
   float pmf = 1.0f;
   uint child = LT_NODE(0u).child;
   while (trail > 1u) {
-    GpuLightNode a = LT_NODE(child);
-    GpuLightNode b = LT_NODE(child + 1u);
-    float p0 = lt_first_child_probability(lt_importance(a, x, n), lt_importance(b, x, n));
+    uvec4 node;
+    vec4 w;
+    lt_step(child, x, n, node, w);
+    float p0 = lt_first_child_probability(w.x + w.y, w.z + w.w);
     if (p0 < 0.0f) return 0.0f;
     bool second = (trail & 1u) != 0u;
-    pmf *= second ? 1.0f - p0 : p0;
-    child = second ? b.child : a.child;
     trail = trail >> 1u;
+    pmf *= second ? 1.0f - p0 : p0;
+    vec2 pw = second ? vec2(w.z, w.w) : vec2(w.x, w.y);
+    uvec2 pn = second ? uvec2(node.z, node.w) : uvec2(node.x, node.y);
+    if (pn.x == pn.y) break;  // the child is a leaf: the trail ends here
+    float p1 = lt_first_child_probability(pw.x, pw.y);
+    if (p1 < 0.0f) return 0.0f;
+    bool second1 = (trail & 1u) != 0u;
+    trail = trail >> 1u;
+    pmf *= second1 ? 1.0f - p1 : p1;
+    child = LT_NODE(second1 ? pn.y : pn.x).child;
   }
   return pmf;
 }
