@@ -2,10 +2,11 @@
 // surfaces.glsl samples it): a binary tree whose nodes bound their triangles' positions (a box),
 // front normals (a cone) and power, so that a shading point x picks a triangle by descending from
 // the root, two levels a step, choosing among a node's grandchildren in proportion to an
-// importance that falls off with distance and vanishes where no triangle below can face x (Conty Estevez and Kulla 2018, "Importance Sampling
-// of Many Lights with Adaptive Tree Splitting"; pbrt-v4's BVHLightSampler). Among thousands of
-// small lamps the ones near x and facing it get most samples, which a choice by power alone
-// cannot do (notes/city.md). Shared by C++ and GLSL: the tests descend the tree with this code.
+// importance that falls off with distance and vanishes where no triangle below can face x (Conty
+// Estevez and Kulla 2018, "Importance Sampling of Many Lights with Adaptive Tree Splitting";
+// pbrt-v4's BVHLightSampler). Among thousands of small lamps the ones near x and facing it get
+// most samples, which a choice by power alone cannot do (notes/city.md). Shared by C++ and GLSL:
+// the tests descend the tree with this code.
 //
 // Correctness needs one property only: importance 0 where no triangle of the node can send light
 // to x (then the descent never picks what it cannot reach, and the probability of every
@@ -167,7 +168,7 @@ PLUME_FN uint lt_sample(vec3 x, vec3 n, float u, OUT(float) pmf) {
     // within the chosen pair (its sum is positive: a pair of sum 0 has probability 0)
     vec2 pw = second ? vec2(w.z, w.w) : vec2(w.x, w.y);
     uvec2 pn = second ? uvec2(node.z, node.w) : uvec2(node.x, node.y);
-    float p1 = pw.x / (pw.x + pw.y);
+    float p1 = lt_first_child_probability(pw.x, pw.y);
     bool second1 = u >= p1;
     u = second1 ? (u - p1) / (1.0f - p1) : u / p1;
     pmf *= second1 ? 1.0f - p1 : p1;
