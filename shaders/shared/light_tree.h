@@ -16,8 +16,9 @@
 // direction centre -> x, and every front normal within theta_o of the axis, so no triangle faces
 // x where theta_w - theta_o - theta_b >= 90 degrees.
 //
-// How much a node weighs beside its sibling is an estimate only (any positive value where light
-// can arrive keeps the estimators unbiased), and the distance term decides it: the node's power
+// How much a node weighs beside the other candidates of its step (the descent below) is an
+// estimate only (any positive value where light can arrive keeps the estimators unbiased), and
+// the distance term decides it: the node's power
 // times the mean of 1 / d² over its bounding sphere as if its emitters filled it, seen from x
 // (exact for a uniform ball: 3/4 (2 + (1 - a²)/a ln|(1 + a)/(1 - a)|) / r² at a = D / r; 3 / r² at
 // its centre, where 1 / D² would be infinite). A node's sphere that holds x holds emitters near x,
@@ -132,7 +133,8 @@ PLUME_NS_BEGIN
 // smaller sphere), so under a street lamp the lamp's side of the tree weighs more; and it costs as
 // many importances as two binary levels, in half the loop's iterations (notes/city.md "Session
 // 36"). The choice is made as two binary ones: the child by the sum of its pair, then the
-// grandchild within it, so the probabilities and the rescaled number are lt_first_child_probability's.
+// grandchild within it, so the probabilities and the rescaled number are
+// lt_first_child_probability's.
 // lt_step fills the four candidates' node indices and importances: slots x, y under the first
 // child, z, w under the second; a leaf child fills its first slot with itself and its second with
 // the same index and importance 0.
