@@ -179,7 +179,8 @@ TEST(LightTree, EachStepPicksAGrandchildByItsImportance) {
   std::uniform_real_distribution<float> u01(0.0f, 1.0f);
   auto point = [&](float r) { return r * glm::vec3(2.0f * u01(gen) - 1.0f, 2.0f * u01(gen) - 1.0f, 2.0f * u01(gen) - 1.0f); };
   int compared = 0;
-  double worst = 0.0;  // the largest relative difference
+  int leafBesideInner = 0;  // steps where one child is a leaf and its sibling is not
+  double worst = 0.0;       // the largest relative difference
   for (const int n : {2, 3, 5, 6, 1000}) {
     std::vector<LightTreeEmitter> e;
     for (int i = 0; i < n; ++i) {
@@ -202,6 +203,7 @@ TEST(LightTree, EachStepPicksAGrandchildByItsImportance) {
           return;
         }
         std::vector<uint32_t> cand;
+        if (((nodes[nd.child].child ^ nodes[nd.child + 1u].child) & shared::LT_LEAF) != 0u) ++leafBesideInner;
         for (const uint32_t c : {nd.child, nd.child + 1u}) {
           if (nodes[c].child & shared::LT_LEAF) {
             cand.push_back(c);
@@ -229,7 +231,9 @@ TEST(LightTree, EachStepPicksAGrandchildByItsImportance) {
     }
   }
   EXPECT_EQ(compared, 50 * (2 + 3 + 5 + 6 + 1000));
-  std::printf("largest relative difference from the walk: %.3g\n", worst);
+  EXPECT_GT(leafBesideInner, 0) << "no step had a leaf child beside an inner one";
+  std::printf("largest relative difference from the walk: %.3g; steps with a leaf beside an inner child: %d\n", worst,
+              leafBesideInner);
 }
 
 // The light tree (shared/light_tree.h, built by buildLightTree) over random emitters of every
