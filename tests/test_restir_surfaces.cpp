@@ -46,6 +46,20 @@ TEST_F(GpuRestirSurfaces, EmissiveQuadsAsTheOnlyLightsMatchReference) {
                                      test::makeNoiseGrid(32, 1.0 / 16, 7), 256, 4096, "emissive_quads");
 }
 
+// The same with one shadowed light sample a candidate vertex (render.restir_light_candidates 1)
+// instead of light resampling: the candidates' weights then use the target's own light term
+// (restir/candidates.glsl), so the two must agree on the emitters' MIS weight, which the target
+// leaves out (restir/bridge.glsl rs_path_contribution). Can it fail: with the candidates' light
+// term weighted by it and the target not (W then w_sum over a different function), mean ratio
+// 0.980-0.982, aggregate z -4.1 (session 37).
+TEST_F(GpuRestirSurfaces, EmissiveQuadsWithOneLightSampleAVertexMatchReference) {
+  RestirOptions one = test::spatialReuse(shared::RS_MIS_PAIRWISE);
+  one.lightCandidates = 1;
+  test::expectRestirMatchesReference(ctx(), compiler(), test::emissiveQuadsScene(16, 3, 0.5f),
+                                     test::makeNoiseGrid(32, 1.0 / 16, 7), 256, 4096,
+                                     "emissive_quads_one_light_sample", {shared::RS_MIS_PAIRWISE}, one);
+}
+
 // Lamps seen directly (support/scenes.h lampsSeenDirectlyScene; most of the image): their
 // reservoir of its own (restir/candidates.glsl rs_lamp_reservoir: 16 stratified camera rays as
 // candidates, the previous frame's reservoir merged in by the generalised balance heuristic when

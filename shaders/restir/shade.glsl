@@ -149,9 +149,10 @@ vec3 rs_shade(RsDomain D, uint pixelIndex, uint set, inout RngState rng) {
     // reservoir's p̂ is the target of its path in this domain: candidates.glsl, reuse.glsl), and
     // the estimate of the fine transmittances' ratio to the target's (bridge.glsl).
     float est;
-    vec3 f = rs_path_contribution(D, set, pixelIndex, true, rng, est);
+    float mis;
+    vec3 f = rs_path_contribution(D, set, pixelIndex, true, rng, est, mis);
     float lum = rs_luminance(f);
-    if (lum > 0.0f) L += (r.W * r.p_hat / lum) * est * f;
+    if (lum > 0.0f) L += (r.W * r.p_hat / lum) * est * mis * f;
   }
 #ifdef PLUME_HAS_EMITTERS
   // The lamps seen directly: their reservoir's sample (restir/candidates.glsl rs_lamp_reservoir),
