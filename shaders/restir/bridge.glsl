@@ -236,7 +236,7 @@ vec3 rs_light_term(uint v, PathVertex vx, uint light, vec2 ls, uint prim, bool u
 // vertex; the host compiles L > 1 with emissive surfaces only (render/restir.cpp says why).
 // Returns W (0: no sample with a nonzero term) and the survivor's connection `chosenRay` (its
 // value without the emitters' MIS weight), which the candidates' own resampling reads
-// (candidates.glsl: no shadow ray per vertex).
+// (candidates.glsl: one shadow ray per vertex, the survivor's).
 float rs_resample_light(PathVertex vx, vec3 f, inout RngState rng, out uint light, out vec2 ls, out uint prim,
                         out RsLightRay chosenRay) {
   float wSum = 0.0f;

@@ -5,8 +5,8 @@
 // with a light sample: a light chosen in proportion to its estimated power (render/restir.cpp
 // lightChoice), or, with PLUME_RS_LIGHT_CANDIDATES = L > 1 (render.restir_light_candidates), the
 // survivor of L such samples resampled by their unshadowed term (bridge.glsl rs_resample_light),
-// whose RIS weight W_light stands for 1 / p_light below. The candidate ending at vertex j of walk m
-// with light l is the path
+// whose RIS weight W_light stands for 1 / p_light below (the survivor then takes a shadow ray).
+// The candidate ending at vertex j of walk m with light l is the path
 // (u, v, t1, w2, t2, ..., w_j, t_j, l, light sample) with source pdf
 //   p(y) = prod_i sigma_c(x_i) exp(-tau_i) * prod_{i>=2} phase_i * prod q (Russian roulette)
 //          * p_light,
@@ -426,10 +426,15 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
 #endif
       if (wLight > 0.0f) {
 #if PLUME_RS_LIGHT_CANDIDATES > 1
-        // The candidates' own target for a light sample among emissive triangles: the light
-        // term without the light ray's visibility and the emitter's MIS weight (the walk's
-        // target otherwise, header): no shadow ray and no second light-tree pmf per vertex.
+        // The candidates' own target for a light sample among emissive triangles: the target's
+        // light term (visibility, the midpoint rule's transmittance, no MIS weight:
+        // rs_path_contribution) on the survivor of the L samples, whose resampling left the
+        // shadow ray out; one shadow ray a vertex. Without it (sessions 30-36) a walk's
+        // selection was blind to visibility, and a kept path that turned out blocked left the
+        // reservoir empty: on the city a moving frame's relMSE -20 to -24% with it, for +10% time
+        // (notes/city.md "Session 37").
         float ph = rs_luminance(f * lightRay.value) * rs_target_light_tr(VOL_CURRENT, lightRay);
+        if (ph > 0.0f && surf_occluded(lightRay.o, lightRay.w, lightRay.reach)) ph = 0.0f;
 #else
         float ph = rs_luminance(f * rs_light_term(VOL_CURRENT, vx, light, ls, prim, false, rng));
 #endif
@@ -479,13 +484,13 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
   r.M = float(M);
   rs_store_head(outSet, pixelIndex, head);
 #if PLUME_RS_LIGHT_CANDIDATES > 1
-  // The candidates' own target p̂' of light samples left out the light ray's visibility and the
-  // emitter's MIS weight (above), so W = w_sum / p̂'(Y), p̂'(Y) the value rs_update kept for Y times
-  // the segments' transmittances that every weight left out (GRIS: any target of the candidates'
-  // own resampling that is positive wherever p̂ is gives an unbiased contribution weight). The
-  // reservoir's p̂ is the target: 0 where Y's light ray is blocked, and then the reservoir holds
-  // no path (f(Y) = 0, so W f(Y) is 0 either way, and reuse weighs an input by its target in its
-  // own domain).
+  // The candidates' own target p̂' of light samples (above), so W = w_sum / p̂'(Y), p̂'(Y) the
+  // value rs_update kept for Y times the segments' transmittances that every weight left out
+  // (GRIS: any target of the candidates' own resampling that is positive wherever p̂ is gives an
+  // unbiased contribution weight; p̂' is the target itself now, but for the emitter hits' and the
+  // emission's candidates it need not be). The reservoir's p̂ is the target, evaluated once: 0
+  // where Y's light ray is blocked, and then the reservoir holds no path (f(Y) = 0, so W f(Y) is 0
+  // either way, and reuse weighs an input by its target in its own domain).
   float segments = 0.0f;
   float target = head.vertexCount > 0u && r.w_sum > 0.0f ? rs_target_parts(D, outSet, pixelIndex, segments) : 0.0f;
   r.p_hat *= segments;

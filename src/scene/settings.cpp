@@ -70,8 +70,8 @@ const std::vector<SettingDesc>& renderSettingsTable() {
        &RenderSettings::restirMis, 0, 0, {"pairwise", "gbh"}},
       {"restir_light_candidates",
        "ReSTIR: light samples drawn at each candidate vertex and resampled by their unshadowed contribution; "
-       "with more than 1 the candidates are resampled without shadow rays, and only the path a pixel keeps "
-       "is tested (1 = one light sample, shadowed; used with emissive surfaces only)",
+       "with more than 1 only the survivor takes a shadow ray (1 = one light sample, shadowed; used with "
+       "emissive surfaces only)",
        &RenderSettings::restirLightCandidates, 1, 64, {}},
       {"restir_shift",
        "ReSTIR: how reuse moves a path into another pixel where it meets surfaces: reconnect (the first surface "
