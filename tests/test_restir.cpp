@@ -345,7 +345,7 @@ void expectMovingCameraMatches(gpu::Context& ctx, gpu::ShaderCompiler& compiler,
 TEST_F(GpuRestir, MovingCameraMatchesReferencesOfItsPoses) {
   RestirOptions o;
   o.radius = 6;
-  o.historyCapMoving = 5;  // a short one, as the bundled city's 3 (GpuRestirSurfaces' moving test keeps the default 8)
+  o.historyCapMoving = 5;  // a short moving history (the bundled city sets 3; GpuRestirSurfaces' moving test keeps 8)
   expectMovingCameraMatches(ctx(), compiler(), o, "temporal_moving");
 }
 

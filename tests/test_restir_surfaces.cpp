@@ -153,6 +153,10 @@ TEST_F(GpuRestirSurfaces, LampPiecesLeaveLessNoiseThanRaysInTheirRectangle) {
 TEST_F(GpuRestirSurfaces, MovingCameraMatchesReferenceOfItsLastPose) {
   RestirOptions o = test::spatialReuse(shared::RS_MIS_PAIRWISE);
   o.historyCap = 20;
+  // Four light samples a candidate vertex in the frames whose camera moved (two in the first,
+  // which has no history): the candidates' pipeline changes between frames, as the bundled city's
+  // does (render.restir_light_candidates_moving).
+  o.lightCandidatesMoving = 4;
   for (Scene s : {test::emissiveQuadsScene(16, 3, 0.5f), test::smokeOverGroundScene(16, 3)}) {
     CameraKey key;
     key.frame = 4;
@@ -164,6 +168,39 @@ TEST_F(GpuRestirSurfaces, MovingCameraMatchesReferenceOfItsLastPose) {
                                        emitters ? "moving_emissive_quads" : "moving_smoke_over_ground",
                                        {shared::RS_MIS_PAIRWISE, shared::RS_MIS_GBH}, o, 4);
   }
+}
+
+// render.restir_light_candidates_moving takes effect only in frames whose camera moved: with a
+// still camera the image is the plain setting's to the bit, with a moving one it differs (the
+// moving pipeline's candidates resample another number of light samples a vertex).
+TEST_F(GpuRestirSurfaces, LightCandidatesWhileMovingActOnlyWhenTheCameraMoves) {
+  RestirOptions plain = test::spatialReuse(shared::RS_MIS_PAIRWISE);
+  plain.historyCap = 20;
+  RestirOptions more = plain;
+  more.lightCandidatesMoving = 4;
+  test::ExtremeCase c;
+  c.name = "light_candidates_moving";
+  c.scene = test::emissiveQuadsScene(16, 3, 0.5f);
+  c.grid = test::makeNoiseGrid(32, 1.0 / 16, 7);
+  auto differing = [&](const Scene& s) {
+    c.scene = s;
+    const Image a = test::runRestirCase(ctx(), compiler(), c, 2, plain, 3).image;
+    const Image b = test::runRestirCase(ctx(), compiler(), c, 2, more, 3).image;
+    size_t n = 0;
+    for (size_t i = 0; i + 2 < a.rgb.size(); i += 3) {
+      n += a.rgb[i] != b.rgb[i] || a.rgb[i + 1] != b.rgb[i + 1] || a.rgb[i + 2] != b.rgb[i + 2] ? 1 : 0;
+    }
+    return n;
+  };
+  const Scene still = c.scene;
+  Scene moving = still;
+  CameraKey key;
+  key.frame = 3;
+  key.pose = moving.camera.base;
+  key.pose.position += glm::vec3(0.12f, 0.04f, 0.0f);
+  moving.camera.keys.push_back(key);
+  EXPECT_EQ(differing(still), 0u) << "a still camera must keep restir_light_candidates";
+  EXPECT_GT(differing(moving), 256u / 4u) << "a moving camera's frames must use restir_light_candidates_moving";
 }
 
 // A black quad in front of the left half of the smoke: spatial reuse must not bring the smoke's

@@ -132,6 +132,7 @@ RenderSettings withRestir(RenderSettings rs, const RestirOptions& v) {
   rs.restirHistoryCapStatic = v.historyCapStatic;
   rs.restirPrefix = v.prefix;
   rs.restirLightCandidates = v.lightCandidates;
+  rs.restirLightCandidatesMoving = v.lightCandidatesMoving;
   rs.restirShift = v.reconnect ? "reconnect" : "copy";
   return rs;
 }

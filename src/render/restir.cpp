@@ -20,6 +20,7 @@ std::string RestirOptions::name() const {
   // The light candidates likewise.
   const std::string k = (prefix == RestirOptions{}.prefix ? "" : strf(" K%d", prefix)) +
                         (lightCandidates == RestirOptions{}.lightCandidates ? "" : strf(" L%d", lightCandidates)) +
+                        (lightCandidatesMoving == RestirOptions{}.lightCandidatesMoving ? "" : strf(" Lm%d", lightCandidatesMoving)) +
                         (historyCapMoving == RestirOptions{}.historyCapMoving ? "" : strf(" cm%d", historyCapMoving)) +
                         (historyCapStatic == RestirOptions{}.historyCapStatic ? "" : strf(" cs%d", historyCapStatic)) +
                         (candidatesMoving == RestirOptions{}.candidatesMoving ? "" : strf(" Mm%d", candidatesMoving)) +
@@ -44,6 +45,7 @@ RestirOptions restirOptionsOf(const RenderSettings& rs) {
   o.mis = rs.restirMis == "gbh" ? shared::RS_MIS_GBH : shared::RS_MIS_PAIRWISE;
   o.prefix = rs.restirPrefix;
   o.lightCandidates = rs.restirLightCandidates;
+  o.lightCandidatesMoving = rs.restirLightCandidatesMoving;
   o.reconnect = rs.restirShift != "copy";
   return o;
 }
@@ -162,6 +164,10 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   if (options_.lightCandidates < 1 || options_.lightCandidates > 64) {
     throw InputError(scene.path + strf(": render.restir_light_candidates: expected 1 to 64 (got %d)", options_.lightCandidates));
   }
+  if (options_.lightCandidatesMoving < 0 || options_.lightCandidatesMoving > 64) {
+    throw InputError(scene.path + strf(": render.restir_light_candidates_moving: expected 0 to 64 (got %d)",
+                                       options_.lightCandidatesMoving));
+  }
   // Light resampling (restir/bridge.glsl rs_resample_light) only where it was measured to help:
   // among emissive triangles. With a sun and a sky behind dense, strongly forward-scattering smoke
   // the unshadowed term prefers the sun, whose rays the smoke blocks, and L = 2 made the sky's
@@ -188,7 +194,7 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   // Each pass is compiled with only the code its options use (MIS kind, temporal or spatial,
   // light types): on a SIMD back end such as lavapipe the straight-line code of branches not
   // taken still runs under a mask (measured: -20 to -40% per reuse pass).
-  auto make = [&](const char* file, const char* name, gpu::ShaderDefines extra) {
+  auto make = [&](const char* file, const char* name, gpu::ShaderDefines extra, int light = 0) {
     gpu::ShaderDefines d = defines;
     // Final shading's unbiased transmittances of light rays, escaping camera rays and the tail's
     // light rays: residual ratio tracking against the mean field (volume/walk.glsl) at 16x the
@@ -198,7 +204,7 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
     // segments take vol_residual_ratio at PLUME_RS_RATIO_SCALE brick majorants (session 27).
     d.emplace_back("PLUME_RS_RESIDUAL_SCALE", "16.0f");
     d.emplace_back("PLUME_RS_MIS", std::to_string(options_.mis) + "u");
-    d.emplace_back("PLUME_RS_LIGHT_CANDIDATES", std::to_string(lightCandidates));
+    d.emplace_back("PLUME_RS_LIGHT_CANDIDATES", std::to_string(light > 0 ? light : lightCandidates));
     // The reconnection shift only where there are surface vertices to reconnect to.
     if (features_.surfaces && options_.reconnect) d.emplace_back("PLUME_RS_RECONNECT", "1");
     if (verticesInBuffer_) d.emplace_back("PLUME_RS_VERTEX_BUFFER", "1");
@@ -207,6 +213,13 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
                                               uint32_t(sizeof(shared::RsPush)), name + variant, glm::uvec3(64, 1, 1));
   };
   candidates_ = make("passes/restir_candidates.comp", "restir candidates", {});
+  // Frames whose camera moved may resample another number of light samples a vertex: a per-frame
+  // constant of the canonical reservoir's candidates, as their M is (fillFrame), so reuse stays
+  // unbiased. A pipeline of its own (L is compiled in), with emissive surfaces only.
+  const int lightMoving = features_.emitters ? options_.lightCandidatesMoving : 0;
+  if (lightMoving > 0 && lightMoving != lightCandidates) {
+    candidatesMoving_ = make("passes/restir_candidates.comp", "restir candidates (moving)", {}, lightMoving);
+  }
   // The lamps seen directly, over the pixels whose camera rays may meet an emitter (restir/candidates.glsl).
   if (features_.emitters) {
     gpu::ShaderDefines lampDefines;
@@ -329,7 +342,7 @@ void Restir::setVolumes(const GpuVolumeResources& current, const GpuVolumeResour
 std::vector<gpu::ComputePass*> Restir::passes() const {
   std::vector<gpu::ComputePass*> p = {candidates_.get(), temporal_.get(), temporalSame_.get(), spatial_.get(),
                                       shade_.get()};
-  for (gpu::ComputePass* q : {candidatesOut_.get(), temporalOut_.get(), spatialOut_.get(), shadeOut_.get(), tail_.get(),
+  for (gpu::ComputePass* q : {candidatesMoving_.get(), candidatesOut_.get(), temporalOut_.get(), spatialOut_.get(), shadeOut_.get(), tail_.get(),
                               lamps_.get(), lampsRect_.get()}) {
     if (q) p.push_back(q);
   }
@@ -358,6 +371,7 @@ void Restir::fillFrame(int frame, uint32_t sequence, uint32_t key) {
   // whose camera moved since the previous frame of the sequence (the first frame keeps M).
   const bool moved = hasHistory_ && prevSequence_ == sequence && !still;
   params_.candidates = uint32_t(moved && options_.candidatesMoving > 0 ? options_.candidatesMoving : options_.candidates);
+  moved_ = moved;  // and their light samples a vertex (candidatesMoving_)
   // And the spatial rounds where nothing changed (a per-frame constant too: which neighbours a
   // pixel reuses never depends on a sample).
   rounds_ = still && sameVolume && options_.roundsStatic >= 0 ? options_.roundsStatic : options_.rounds;
@@ -548,7 +562,8 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
     for (uint32_t m = 0; m < params_.candidates; m += params_.walksPerDispatch) {
       if (m > 0) gpu::computeBarrier(cmd);
       push.candidate = m;
-      over(*candidates_, push, 0, inside);  // (every pixel is inside without the outside variants)
+      const gpu::ComputePass& walks = moved_ && candidatesMoving_ ? *candidatesMoving_ : *candidates_;
+      over(walks, push, 0, inside);  // (every pixel is inside without the outside variants)
     }
     push.candidate = 0;
     if (candidatesOut_) over(*candidatesOut_, push, inside, all - inside);

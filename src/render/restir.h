@@ -43,6 +43,7 @@ struct RestirOptions {
   int prefix = 16;           // K: vertices a reservoir's path holds (<= RS_MAX_VERTICES); the paths
                              // of more vertices are path traced in final shading (notes/restir.md)
   int lightCandidates = 2;   // L: light samples resampled at each candidate vertex (restir/bridge.glsl)
+  int lightCandidatesMoving = 0;  // L while the camera moves (0: lightCandidates)
   bool reconnect = true;     // the reconnection shift at the first surface vertex after the primary
                              // (false: the copy shift; shared/restir_types.h)
   // Tests only (no scene setting): when not (0, 0), every spatial round reuses exactly one
@@ -141,6 +142,8 @@ class Restir {
   std::unique_ptr<GpuEnvironmentMap> envMap_;
   std::unique_ptr<GpuSurfaces> surfaces_;  // only for a scene with surfaces
   std::unique_ptr<gpu::ComputePass> candidates_, temporal_, temporalSame_, spatial_, shade_;
+  std::unique_ptr<gpu::ComputePass> candidatesMoving_;  // with lightCandidatesMoving (null: candidates_ serves)
+  bool moved_ = false;  // this frame's camera moved since the previous frame of the sequence (fillFrame)
   std::unique_ptr<gpu::ComputePass> lamps_;  // the lamps seen directly (only with emissive surfaces)
   std::unique_ptr<gpu::ComputePass> lampsRect_;  // with pieces, for the pixels whose pieces do not fit
   // The passes' variants for the pixels whose camera rays miss the volume (PLUME_RS_OUTSIDE;

@@ -73,6 +73,12 @@ const std::vector<SettingDesc>& renderSettingsTable() {
        "with more than 1 only the survivor takes a shadow ray (1 = one light sample, shadowed; used with "
        "emissive surfaces only)",
        &RenderSettings::restirLightCandidates, 1, 64, {}},
+      {"restir_light_candidates_moving",
+       "ReSTIR: light samples resampled at each candidate vertex in frames whose camera moved (0 = "
+       "restir_light_candidates; emissive surfaces only). A moving camera's reservoirs hold few frames of "
+       "history, so a better light choice per candidate pays there sooner than with a still one (the bundled "
+       "city: 4 while moving, with 3 candidates, notes/city.md \"Session 37\")",
+       &RenderSettings::restirLightCandidatesMoving, 0, 64, {}},
       {"restir_shift",
        "ReSTIR: how reuse moves a path into another pixel where it meets surfaces: reconnect (the first surface "
        "vertex after the primary one is kept in place and the shifted path connects to it) or copy (every "

@@ -39,6 +39,7 @@ struct RenderSettings {
   std::string restirMis = "pairwise";  // pairwise | gbh (generalised balance heuristic)
   int restirPrefix = 16;             // path vertices a reservoir holds; longer paths: a path-traced tail
   int restirLightCandidates = 2;     // light samples resampled at each candidate vertex (RIS)
+  int restirLightCandidatesMoving = 0;  // ... in frames whose camera moved (0: restirLightCandidates)
   std::string restirShift = "reconnect";  // reconnect (at the first surface vertex after the primary) | copy
 };
 
