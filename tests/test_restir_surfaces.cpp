@@ -157,12 +157,8 @@ TEST_F(GpuRestirSurfaces, MovingCameraMatchesReferenceOfItsLastPose) {
   // which has no history): the candidates' pipeline changes between frames, as the bundled city's
   // does (render.restir_light_candidates_moving).
   o.lightCandidatesMoving = 4;
-  for (Scene s : {test::emissiveQuadsScene(16, 3, 0.5f), test::smokeOverGroundScene(16, 3)}) {
-    CameraKey key;
-    key.frame = 4;
-    key.pose = s.camera.base;
-    key.pose.position += glm::vec3(0.12f, 0.04f, 0.0f);
-    s.camera.keys.push_back(key);
+  for (Scene base : {test::emissiveQuadsScene(16, 3, 0.5f), test::smokeOverGroundScene(16, 3)}) {
+    const Scene s = test::cameraMovedBy(base, 4, {0.12f, 0.04f, 0.0f});
     const bool emitters = s.lights.empty();
     test::expectRestirMatchesReference(ctx(), compiler(), s, test::makeNoiseGrid(32, 1.0 / 16, 7), 256, 16384,
                                        emitters ? "moving_emissive_quads" : "moving_smoke_over_ground",
@@ -193,12 +189,7 @@ TEST_F(GpuRestirSurfaces, LightCandidatesWhileMovingActOnlyWhenTheCameraMoves) {
     return n;
   };
   const Scene still = c.scene;
-  Scene moving = still;
-  CameraKey key;
-  key.frame = 3;
-  key.pose = moving.camera.base;
-  key.pose.position += glm::vec3(0.12f, 0.04f, 0.0f);
-  moving.camera.keys.push_back(key);
+  const Scene moving = test::cameraMovedBy(still, 3, {0.12f, 0.04f, 0.0f});
   EXPECT_EQ(differing(still), 0u) << "a still camera must keep restir_light_candidates";
   EXPECT_GT(differing(moving), 256u / 4u) << "a moving camera's frames must use restir_light_candidates_moving";
 }

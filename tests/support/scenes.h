@@ -160,4 +160,15 @@ inline Scene sunlitWallScene(int size, int bounces) {
   return s;
 }
 
+// The scene with its camera keyed to have moved by `offset` from its base pose at frame `frame`
+// (interpolated from frame 1 on: a camera that moves every frame).
+inline Scene cameraMovedBy(Scene s, int frame, glm::vec3 offset) {
+  CameraKey key;
+  key.frame = frame;
+  key.pose = s.camera.base;
+  key.pose.position += offset;
+  s.camera.keys.push_back(key);
+  return s;
+}
+
 }  // namespace plume::test
