@@ -342,8 +342,8 @@ void Restir::setVolumes(const GpuVolumeResources& current, const GpuVolumeResour
 std::vector<gpu::ComputePass*> Restir::passes() const {
   std::vector<gpu::ComputePass*> p = {candidates_.get(), temporal_.get(), temporalSame_.get(), spatial_.get(),
                                       shade_.get()};
-  for (gpu::ComputePass* q : {candidatesMoving_.get(), candidatesOut_.get(), temporalOut_.get(), spatialOut_.get(), shadeOut_.get(), tail_.get(),
-                              lamps_.get(), lampsRect_.get()}) {
+  for (gpu::ComputePass* q : {candidatesMoving_.get(), candidatesOut_.get(), temporalOut_.get(), spatialOut_.get(),
+                              shadeOut_.get(), tail_.get(), lamps_.get(), lampsRect_.get()}) {
     if (q) p.push_back(q);
   }
   return p;
