@@ -148,6 +148,14 @@ struct RsLightRay {
   vec3 value;
 };
 
+#ifdef PLUME_HAS_EMITTERS
+// The MIS weight of a light sample on emissive triangle prim, at distance dist along w from the
+// ray origin o of vertex vx, with cosine cosLight there, against the vertex's direction sampling.
+float rs_light_sample_mis(PathVertex vx, uint prim, vec3 o, vec3 w, float dist, float cosLight) {
+  return rs_emitter_weight(rs_emitter_light_pdf(prim, o, vtx_receiver(vx), dist, cosLight), vtx_at_pdf(vx, w));
+}
+#endif
+
 bool rs_light_connect(PathVertex vx, uint light, vec2 ls, uint prim, bool withMis, out RsLightRay c) {
 #ifdef PLUME_HAS_EMITTERS
   if (light == frame.lightCount) {
@@ -161,7 +169,7 @@ bool rs_light_connect(PathVertex vx, uint light, vec2 ls, uint prim, bool withMi
     c.value = vec3(0.0f);
     if (!(dist > 0.0f) || !(cosLight > 0.0f)) return false;
     vec3 scatter = vtx_at_scatter(vx, c.w);
-    float mis = withMis ? rs_emitter_weight(rs_emitter_light_pdf(prim, c.o, vtx_receiver(vx), dist, cosLight), vtx_at_pdf(vx, c.w)) : 1.0f;
+    float mis = withMis ? rs_light_sample_mis(vx, prim, c.o, c.w, dist, cosLight) : 1.0f;
     c.value = surf_emission(prim) * scatter * (mis * cosLight / (dist * dist));
     return true;
   }
@@ -189,8 +197,7 @@ float rs_light_mis(PathVertex vx, uint light, vec2 ls, uint prim, RsLightRay c) 
 #ifdef PLUME_HAS_EMITTERS
   if (light == frame.lightCount) {
     float dist = length(surf_triangle_point(prim, ls) - c.o);
-    float cosLight = -dot(surf_normal(prim), c.w);
-    return rs_emitter_weight(rs_emitter_light_pdf(prim, c.o, vtx_receiver(vx), dist, cosLight), vtx_at_pdf(vx, c.w));
+    return rs_light_sample_mis(vx, prim, c.o, c.w, dist, -dot(surf_normal(prim), c.w));
   }
 #endif
   return 1.0f;
