@@ -259,7 +259,9 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
   // back end such as lavapipe runs it under a mask otherwise). All M walks in one dispatch.
   walkVertices = 0u;
 #endif
-  float q = min(1.0f, plume_max3(vtx_albedo(VERTEX_MEDIUM)));
+#ifndef PLUME_HAS_SURFACES
+  float q = min(1.0f, plume_max3(vtx_albedo(VERTEX_MEDIUM)));  // the roulette's (below)
+#endif
   uint base = rs_bounce_base(outSet, pixelIndex);
   RsReservoir r = rs_empty();
   RsPathHead head;
@@ -445,8 +447,16 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
         }
       }
       if (j == walkVertices) break;
-      if (j >= frame.rrStartBounce) {  // Russian roulette with a fixed probability: part of the pdf
-        if (rng_float(rng) >= q) break;
+      if (j >= frame.rrStartBounce) {  // Russian roulette: its probability is part of the pdf
+#ifdef PLUME_HAS_SURFACES
+        // On the walk's throughput f / p, as the path tracer's: a fixed probability (the
+        // medium's albedo, below) let nearly every walk over dark ground and walls run to
+        // max_bounces, each vertex with its light samples and shadow ray, for paths that carry
+        // a few percent of the light (on the city a moving frame -12% time, the same error:
+        // notes/city.md "Session 38"). A function of the walk so far, so the pdf knows it.
+        float q = min(1.0f, plume_max3(f) / pdf);
+#endif
+        if (!(rng_float(rng) < q)) break;
         pdf *= q;
       }
 #ifdef PLUME_HAS_SURFACES

@@ -549,8 +549,8 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
     };
     // walksPerDispatch candidate walks per dispatch (lavapipe's loop budget: restir/candidates.glsl);
     // the outside variant's M walks (none of them reaches a vertex) in one.
-    const uint32_t candidates = timer_.begin(cmd, "restir candidates");
     if (lamps_) {  // (its pixels' lamp reservoirs; the candidates pass writes the others')
+      const uint32_t lampScope = timer_.begin(cmd, "restir lamps");
       const uint32_t listBegin = all + (all + 31) / 32;
       if (lampsRect_) {
         over(*lamps_, push, listBegin, lampPixels_ - lampRectPixels_);
@@ -558,7 +558,10 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
       } else {
         over(*lamps_, push, listBegin, lampPixels_);
       }
+      timer_.end(cmd, lampScope);
+      labels.push_back("lamps");
     }
+    const uint32_t candidates = timer_.begin(cmd, "restir candidates");
     for (uint32_t m = 0; m < params_.candidates; m += params_.walksPerDispatch) {
       if (m > 0) gpu::computeBarrier(cmd);
       push.candidate = m;
