@@ -74,6 +74,44 @@ TEST_F(GpuRestirSurfaces, RouletteOnTheThroughputMatchesReference) {
                                      "roulette_on_the_throughput", {shared::RS_MIS_PAIRWISE});
 }
 
+// The candidates' target of the selected path: p̂' (the value the candidates' resampling kept for
+// it) times the mean field's transmittance along its segments, gathered while the walk went
+// (restir/candidates.glsl; re-evaluated from the stored path until session 38), must be the target
+// that reuse evaluates for that path: with a still camera the same-domain temporal pipeline reads
+// each input's p̂ as stored where the general one evaluates it (rs_cross_targets), so their frames
+// agree only if the two are one function. Emissive quads (light resampling, L = 2) in smoke 4x
+// denser than the other scenes', where the segments' transmittance is far from 1; temporal and
+// spatial reuse over 4 frames. Can it fail: with the segments' factor left out of the stored p̂
+// (and of W, so that W p̂ stays right) the two pipelines differ by up to 4.5 (relative) in 519 of
+// 600 lit channels; with the walk's whole product taken for the selected candidate's, 2.45 in 585
+// of 597. Correct: 1.4e-6 (3.4e-7 when the candidates re-evaluated the target).
+TEST_F(GpuRestirSurfaces, CandidatesTargetIsTheTargetReuseEvaluates) {
+  RestirOptions same = test::spatialReuse(shared::RS_MIS_PAIRWISE);
+  same.historyCap = 20;
+  RestirOptions general = same;
+  general.sameDomainTemporal = false;
+  test::ExtremeCase c;
+  c.name = "candidates_target";
+  c.scene = test::emissiveQuadsScene(16, 3, 0.5f);
+  c.scene.medium().densityScale *= 4.0f;
+  c.grid = test::makeNoiseGrid(32, 1.0 / 16, 7);
+  const Image a = test::runRestirCase(ctx(), compiler(), c, 2, same, 4).image;
+  const Image b = test::runRestirCase(ctx(), compiler(), c, 2, general, 4).image;
+  double worst = 0.0;
+  size_t lit = 0, differ = 0;
+  for (size_t i = 0; i < a.rgb.size(); ++i) {
+    if (!(b.rgb[i] > 0.0f)) continue;
+    ++lit;
+    const double d = std::abs(double(a.rgb[i]) - double(b.rgb[i])) / double(b.rgb[i]);
+    worst = std::max(worst, d);
+    differ += d > 1e-5 ? 1 : 0;
+  }
+  std::printf("[restir] candidates' target against reuse's: worst relative difference %.3g over %zu lit channels (%zu "
+              "above 1e-5)\n", worst, lit, differ);
+  ASSERT_GT(lit, a.rgb.size() / 2) << "too few lit channels to compare";
+  EXPECT_LT(worst, 1e-5) << "the stored target must be the one reuse evaluates, to rounding";
+}
+
 // Lamps seen directly (support/scenes.h lampsSeenDirectlyScene; most of the image): their
 // reservoir of its own (restir/candidates.glsl rs_lamp_reservoir: 16 stratified camera rays as
 // candidates, the previous frame's reservoir merged in by the generalised balance heuristic when

@@ -38,6 +38,9 @@
 #if defined(PLUME_RS_OUTSIDE) && defined(PLUME_HAS_SURFACES)
 #error "PLUME_RS_OUTSIDE: a camera ray may meet a surface anywhere"
 #endif
+#if PLUME_RS_LIGHT_CANDIDATES > 1 && !defined(PLUME_HAS_SURFACES)
+#error "light resampling (L > 1) is compiled with emissive surfaces only: the walk gathers its segments' transmittance there"
+#endif
 
 // The head of the path a candidate ending at vertex j of a walk stands for (vertices 2..j are the
 // walk's, copied when the walk ends).
@@ -265,6 +268,11 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
   uint base = rs_bounce_base(outSet, pixelIndex);
   RsReservoir r = rs_empty();
   RsPathHead head;
+#if PLUME_RS_LIGHT_CANDIDATES > 1
+  // The mean field's transmittance along the selected candidate's segments: the factor of its
+  // target that the weights leave out (see the end).
+  float segmentsKeep = 0.0f;
+#endif
   if (first == 0u) {
     head.lightSample = vec2(0.0f);
     head.t1 = 0.0f;
@@ -278,6 +286,9 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
     r.w_sum = state.x;
     r.p_hat = state.y;  // the candidates' own target of the selected one
     rng.counter = floatBitsToUint(state.z);
+#if PLUME_RS_LIGHT_CANDIDATES > 1
+    segmentsKeep = state.w;
+#endif
     head = rs_load_head(outSet, pixelIndex);
   }
 #ifdef PLUME_HAS_EMITTERS
@@ -308,6 +319,9 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
   float t1 = 0.0f;
   uint keep = 0u;   // vertices of this walk's selected candidate (0: none): copied when the walk ends
   uint kinds = 0u;  // this walk's vertex kinds so far (RsPathHead.kinds)
+#if PLUME_RS_LIGHT_CANDIDATES > 1
+  float segmentsWalk = 1.0f;  // the mean field's transmittance along the walk's segments so far
+#endif
   vec4 slot = vec4(0.0f);  // vertex j's stored coordinates (j >= 2)
 #ifdef PLUME_HAS_SURFACES
   PathVertex prev = vtx_medium(x, vec3(0.0f, 0.0f, 1.0f));  // the vertex that sampled w
@@ -324,6 +338,9 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
       keep = 0u;
       kinds = 0u;
       slot = vec4(0.0f);
+#if PLUME_RS_LIGHT_CANDIDATES > 1
+      segmentsWalk = 1.0f;
+#endif
 #ifdef PLUME_HAS_SURFACES
       prev = vtx_medium(x, w);  // the camera's, first
 #endif
@@ -345,6 +362,11 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
       BvhHit hit = bvh_closest(x, w, 0.0f, SURF_FAR);
       float tMax = hit.prim != BVH_NONE ? hit.t : DDA_INF;
       bool collided = vol_mean_sample(x, w, tMax, rng, t, sigmaC);
+#if PLUME_RS_LIGHT_CANDIDATES > 1
+      // This segment's transmittance in the target (rs_path_contribution's vol_mean_tr of the
+      // same ray up to the same vertex)
+      if (collided || hit.prim != BVH_NONE) segmentsWalk *= vol_mean_tr(VOL_CURRENT, x, w, collided ? t : hit.t);
+#endif
       PathVertex vx;
       if (!collided) {
         if (hit.prim == BVH_NONE) break;
@@ -371,6 +393,9 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
           if (rs_update(r, invM * ph / pdf, ph, 0.0f, rng_float(rng))) {
             head = rs_candidate_head(uv, t1, j, kinds, RS_LIGHT_EMITTER_HIT, vec2(0.0f), 0u);
             keep = j;
+#if PLUME_RS_LIGHT_CANDIDATES > 1
+            segmentsKeep = segmentsWalk;
+#endif
           }
         }
 #endif
@@ -396,6 +421,9 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
         if (rs_update(r, invM * ph / pdf, ph, 0.0f, rng_float(rng))) {
           head = rs_candidate_head(uv, t1, j, kinds, RS_LIGHT_EMISSION, vec2(0.0f), 0u);
           keep = j;
+#if PLUME_RS_LIGHT_CANDIDATES > 1
+          segmentsKeep = segmentsWalk;
+#endif
         }
       }
   #endif
@@ -444,6 +472,9 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
         if (rs_update(r, weight, ph, 0.0f, uSelect)) {
           head = rs_candidate_head(uv, t1, j, kinds, light, ls, prim);
           keep = j;
+#if PLUME_RS_LIGHT_CANDIDATES > 1
+          segmentsKeep = segmentsWalk;
+#endif
         }
       }
       if (j == walkVertices) break;
@@ -487,7 +518,11 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
     }
   }
   if (last < M) {
+#if PLUME_RS_LIGHT_CANDIDATES > 1
+    rs_set_state(rs_state_slot(pixelIndex), vec4(r.w_sum, r.p_hat, uintBitsToFloat(rng.counter), segmentsKeep));
+#else
     rs_set_state(rs_state_slot(pixelIndex), vec4(r.w_sum, r.p_hat, uintBitsToFloat(rng.counter), 0.0f));
+#endif
     rs_store_head(outSet, pixelIndex, head);
     return;
   }
@@ -497,12 +532,16 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
   // The candidates' own target p̂' of light samples (above), so W = w_sum / p̂'(Y), p̂'(Y) the
   // value rs_update kept for Y times the segments' transmittances that every weight left out
   // (GRIS: any target of the candidates' own resampling that is positive wherever p̂ is gives an
-  // unbiased contribution weight; p̂' is the target itself now, but for the emitter hits' and the
-  // emission's candidates it need not be). The reservoir's p̂ is the target, evaluated once: 0
-  // where Y's light ray is blocked, and then the reservoir holds no path (f(Y) = 0, so W f(Y) is 0
-  // either way, and reuse weighs an input by its target in its own domain).
-  float segments = 0.0f;
-  float target = head.vertexCount > 0u && r.w_sum > 0.0f ? rs_target_parts(D, outSet, pixelIndex, segments) : 0.0f;
+  // unbiased contribution weight). p̂' is the target without those transmittances (the light
+  // term with its visibility, the emitter hits' and the emission's terms alike), so the
+  // reservoir's p̂, the target of Y, is p̂'(Y) times them: gathered while the walk went
+  // (segmentsKeep: the same mean-field transmittance of the same rays as rs_path_contribution's),
+  // where until session 38 the target was evaluated once more from the stored path, tracing its
+  // rays again (the city's still frames -2.4 ms of 13; reuse reads this value as the input's own
+  // target, so the two must agree: GpuRestirSurfaces.CandidatesTargetIsTheTargetReuseEvaluates).
+  // 0 where Y's light ray is blocked (p̂' is), and then the reservoir holds no path.
+  float segments = segmentsKeep;
+  float target = head.vertexCount > 0u && r.w_sum > 0.0f ? r.p_hat * segments : 0.0f;
   r.p_hat *= segments;
   rs_finalize(r);
   r.p_hat = target;
