@@ -412,14 +412,9 @@ TEST_F(GpuRestir, SameDomainTemporalPipelineMatchesTheGeneralOne) {
   const Scene s = baseScene(16);
   auto meanOf = [&](const RestirOptions& o) { return runRestir(ctx(), compiler(), s, o, spec, [&](int) { return grid; }).mean; };
   const Image a = meanOf(same), b = meanOf(general), c = meanOf(none);
-  double worst = 0.0;
-  size_t lit = 0, differ = 0;
-  for (size_t i = 0; i < a.rgb.size(); ++i) {
-    if (!(b.rgb[i] > 0.0f)) continue;
-    ++lit;
-    worst = std::max(worst, std::abs(double(a.rgb[i]) - double(b.rgb[i])) / double(b.rgb[i]));
-    differ += a.rgb[i] != c.rgb[i] ? 1 : 0;
-  }
+  const auto [worst, lit] = test::relativeAgreement(a, b);
+  size_t differ = 0;
+  for (size_t i = 0; i < a.rgb.size(); ++i) differ += b.rgb[i] > 0.0f && a.rgb[i] != c.rgb[i] ? 1 : 0;
   std::printf("[restir] same-domain temporal: worst relative difference %.3g over %zu lit channels, %zu differ "
               "from no temporal reuse\n", worst, lit, differ);
   ASSERT_GT(lit, a.rgb.size() / 2) << "too few lit channels to compare";

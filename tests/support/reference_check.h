@@ -11,6 +11,8 @@
 #include <glm/common.hpp>
 #include <glm/vec3.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <optional>
 #include <span>
 #include <string>
@@ -76,5 +78,21 @@ ReferenceCheck expectMatchesReference(const Image& image, const Image& reference
                                       const ReferenceCheckOptions& options = {});
 ReferenceCheck expectMatchesExact(const Image& image, std::span<const float> exactRgb, const std::string& label,
                                   const ReferenceCheckOptions& options = {});
+
+// Two images that must agree to rounding (two pipelines of one estimator): the largest relative
+// difference over the channels where `b` is positive, and how many those are.
+struct RelativeAgreement {
+  double worst = 0.0;
+  size_t lit = 0;
+};
+inline RelativeAgreement relativeAgreement(const Image& a, const Image& b) {
+  RelativeAgreement r;
+  for (size_t i = 0; i < a.rgb.size() && i < b.rgb.size(); ++i) {
+    if (!(b.rgb[i] > 0.0f)) continue;
+    ++r.lit;
+    r.worst = std::max(r.worst, std::abs(double(a.rgb[i]) - double(b.rgb[i])) / double(b.rgb[i]));
+  }
+  return r;
+}
 
 }  // namespace plume::test
