@@ -349,6 +349,44 @@ TEST_F(GpuRestir, MovingCameraMatchesReferencesOfItsPoses) {
   expectMovingCameraMatches(ctx(), compiler(), o, "temporal_moving");
 }
 
+// The targets' colour weights (restir/colour.glsl, render.restir_target colour, the default):
+// each pixel's target weighs the channels by the inverse of its colour as the earlier frames
+// estimated it, and the weights change only in frames where the general temporal pipeline runs.
+// Under an orange sun and a blue sky (pixels of very different colours), over frames whose camera
+// moves (the weights change every frame; the history's domain keeps its own) and then stands still
+// (they change once more, at the first still frame, then stay: the same-domain pipeline), the
+// image must match the reference of the last pose; and it must differ from the luminance
+// target's in most lit pixels, with the same random numbers (the weights act: grey weights give
+// the luminance's image bit for bit, both being dot(k, f)).
+TEST_F(GpuRestir, ColourTargetUnderColouredLightsMatchesReference) {
+  Scene s = movedBy(baseScene(16), 3, {1.6f, 1.3f, 3.4f});
+  s.lights = {test::sunLight({0.4f, 1.0f, 0.3f}, {4.0f, 1.6f, 0.3f}), test::skyLight({0.04f, 0.10f, 0.45f})};
+  s.render.maxBounces = 2;
+  auto grid = test::makeNoiseGrid(40, 1.0 / 20, 2);
+  RestirOptions colour;
+  colour.radius = 6;
+  colour.historyCapMoving = 5;
+  RestirOptions luminance = colour;
+  luminance.colourTarget = false;
+  RunSpec spec;
+  spec.framesPerRun = 5;  // frames 2-3 move, 4 is the first still frame, 5 keeps its weights
+  RestirRun run = runRestir(ctx(), compiler(), s, colour, spec, [&](int) { return grid; });
+  expectMatches(run, reference(s, grid, 512, 5), "colour_target");
+  RunSpec two = spec;
+  two.runs = 2;
+  const Image a = runRestir(ctx(), compiler(), s, colour, two, [&](int) { return grid; }).mean;
+  const Image b = runRestir(ctx(), compiler(), s, luminance, two, [&](int) { return grid; }).mean;
+  size_t lit = 0, differ = 0;
+  for (size_t i = 0; i + 2 < a.rgb.size(); i += 3) {
+    if (!(b.rgb[i] + b.rgb[i + 1] + b.rgb[i + 2] > 0.0f)) continue;
+    ++lit;
+    differ += a.rgb[i] != b.rgb[i] || a.rgb[i + 1] != b.rgb[i + 1] || a.rgb[i + 2] != b.rgb[i + 2] ? 1 : 0;
+  }
+  std::printf("[restir] colour target: %zu of %zu lit pixels differ from the luminance target's\n", differ, lit);
+  ASSERT_GT(lit, a.rgb.size() / 6) << "too few lit pixels to compare";
+  EXPECT_GT(differ, lit / 2) << "the colour weights must change the targets";
+}
+
 // Pixels whose value differs between the two options' mean images (two runs of three frames
 // over a noise cloud): under a still camera and under one that moves in the third frame.
 struct DifferingPixels {

@@ -26,10 +26,14 @@ struct RsDomain {
   vec3 du;      // its change per unit of u (one pixel to the right)
   vec3 dv;      // and per unit of v (one pixel down)
   uint v;       // VOL_CURRENT or VOL_PREVIOUS
+  vec3 k;       // the target's colour weights: p̂ = dot(k, f) (restir/colour.glsl)
 };
 
-RsDomain rs_camera_domain(uvec2 pixel, GpuCamera cam, uint v) {
+uint rs_colour_slot(uint set, uint pixelIndex);
+
+RsDomain rs_camera_domain(uvec2 pixel, GpuCamera cam, uint v, uint colourSet) {
   RsDomain D;
+  D.k = rs_state(rs_colour_slot(colourSet, pixel.y * frame.size.x + pixel.x)).xyz;
   D.origin = cam.position;
   D.corner = cam_direction(vec2(pixel), frame.size, cam);
   D.du = (2.0f / float(frame.size.x)) * cam.tanHalfFovY * cam.aspect * cam.right;
@@ -41,8 +45,10 @@ RsDomain rs_camera_domain(uvec2 pixel, GpuCamera cam, uint v) {
 // The camera ray through the point (u, v) of the domain's pixel.
 vec3 rs_domain_dir(RsDomain D, vec2 uv) { return normalize(D.corner + uv.x * D.du + uv.y * D.dv); }
 
-RsDomain rs_current_domain(uvec2 pixel) { return rs_camera_domain(pixel, frame.camera, VOL_CURRENT); }
-RsDomain rs_previous_domain(uvec2 pixel) { return rs_camera_domain(pixel, rsp.prevCamera, VOL_PREVIOUS); }
+RsDomain rs_current_domain(uvec2 pixel) { return rs_camera_domain(pixel, frame.camera, VOL_CURRENT, rsp.colourSet); }
+RsDomain rs_previous_domain(uvec2 pixel) {
+  return rs_camera_domain(pixel, rsp.prevCamera, VOL_PREVIOUS, rsp.colourHistorySet);
+}
 
 // A path's sub-pixel position, stored in RsPathHead.uv as two 16-bit fixed-point numbers;
 // candidates quantise their draw first, so every domain sees exactly the stored value.
@@ -50,6 +56,9 @@ uint rs_pack_uv(vec2 uv) { return packUnorm2x16(uv); }
 vec2 rs_unpack_uv(uint packed) { return unpackUnorm2x16(packed); }
 
 float rs_luminance(vec3 c) { return (c.x + c.y + c.z) * (1.0f / 3.0f); }
+
+// The target's scalar of an RGB contribution c in a domain whose colour weights are k.
+float rs_weigh(vec3 k, vec3 c) { return dot(k, c); }
 
 // --- Light samples -------------------------------------------------------------------------------
 // A path ends in a light sample (light index, two floats): a direction sample is stored as
@@ -244,7 +253,7 @@ vec3 rs_light_term(uint v, PathVertex vx, uint light, vec2 ls, uint prim, bool u
 // Returns W (0: no sample with a nonzero term) and the survivor's connection `chosenRay` (its
 // value without the emitters' MIS weight), which the candidates' own resampling reads
 // (candidates.glsl: one shadow ray per vertex, the survivor's).
-float rs_resample_light(PathVertex vx, vec3 f, inout RngState rng, out uint light, out vec2 ls, out uint prim,
+float rs_resample_light(PathVertex vx, vec3 f, vec3 colour, inout RngState rng, out uint light, out vec2 ls, out uint prim,
                         out RsLightRay chosenRay) {
   float wSum = 0.0f;
   float chosen = 0.0f;
@@ -259,7 +268,7 @@ float rs_resample_light(PathVertex vx, vec3 f, inout RngState rng, out uint ligh
     uint pk;
     float pl = rs_sample_light(vx, vec3(rng_to_float(h.x), rng_to_float(h.y), rng_to_float(h.z)), rng, lk, lsk, pk);
     RsLightRay c;
-    float ph = pl > 0.0f && rs_light_connect(vx, lk, lsk, pk, false, c) ? rs_luminance(f * c.value) : 0.0f;
+    float ph = pl > 0.0f && rs_light_connect(vx, lk, lsk, pk, false, c) ? rs_weigh(colour, f * c.value) : 0.0f;
     float w = pl > 0.0f ? ph / pl : 0.0f;
     if (!(w > 0.0f) || isinf(w)) continue;
     wSum += w;
@@ -320,9 +329,13 @@ void rs_store_head(uint set, uint pixelIndex, RsPathHead h) {
 // rs_state / rs_set_state): the candidates' running reservoir (restir/candidates.glsl), then final
 // shading's tail (restir/shade.glsl).
 uint rs_state_slot(uint pixelIndex) { return 2u * RS_SETS * rsp.pixelCount + RS_STATE_SLOTS * pixelIndex; }
-// A pixel's lamp reservoir of set `set` (RestirParams::lampSet), past the state.
-uint rs_lamp_slot(uint set, uint pixelIndex) {
+// A pixel's colour weights of set `set` (RestirParams::colourSet), past the state.
+uint rs_colour_slot(uint set, uint pixelIndex) {
   return (2u * RS_SETS + RS_STATE_SLOTS + set) * rsp.pixelCount + pixelIndex;
+}
+// A pixel's lamp reservoir of set `set` (RestirParams::lampSet), past the colour weights.
+uint rs_lamp_slot(uint set, uint pixelIndex) {
+  return (2u * RS_SETS + RS_STATE_SLOTS + RS_COLOUR_SLOTS + set) * rsp.pixelCount + pixelIndex;
 }
 
 // Vertex count of the stored path (0: none), and marking a slot empty.
@@ -518,7 +531,7 @@ vec3 rs_path_contribution(RsDomain D, uint set, uint pixelIndex, bool shading, i
 float rs_target_parts(RsDomain D, uint set, uint pixelIndex, out float segments) {
   RngState unused = RngState(uvec4(0u), 0u);  // never drawn from: no hash to pay for
   float mis;
-  return rs_luminance(rs_path_contribution(D, set, pixelIndex, false, unused, segments, mis));
+  return rs_weigh(D.k, rs_path_contribution(D, set, pixelIndex, false, unused, segments, mis));
 }
 
 float rs_target(RsDomain D, uint set, uint pixelIndex) {

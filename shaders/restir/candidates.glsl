@@ -389,7 +389,7 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
         // The candidate ending with the emitter this direction hits (its direction-sampling
         // part, rs_emitter_hit); the camera ray's hit is the lamp reservoir's (rs_lamp_reservoir).
         if (j >= 2u) {
-          float ph = rs_luminance(f * rs_emitter_hit(vtx_at_pdf(prev, w), hit.prim, o, vtx_receiver(prev), w, t));
+          float ph = rs_weigh(D.k, f * rs_emitter_hit(vtx_at_pdf(prev, w), hit.prim, o, vtx_receiver(prev), w, t));
           if (rs_update(r, invM * ph / pdf, ph, 0.0f, rng_float(rng))) {
             head = rs_candidate_head(uv, t1, j, kinds, RS_LIGHT_EMITTER_HIT, vec2(0.0f), 0u);
             keep = j;
@@ -417,7 +417,7 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
 #endif
   #ifdef PLUME_HAS_EMISSION
       if (j >= 2u) {  // the candidate ending with x_j's emission: sigma_a Le instead of scattering
-        float ph = rs_luminance(fArrive * (vec3(1.0f) - vtx_albedo(VERTEX_MEDIUM)) * vol_emitted_radiance_world(VOL_CURRENT, x));
+        float ph = rs_weigh(D.k, fArrive * (vec3(1.0f) - vtx_albedo(VERTEX_MEDIUM)) * vol_emitted_radiance_world(VOL_CURRENT, x));
         if (rs_update(r, invM * ph / pdf, ph, 0.0f, rng_float(rng))) {
           head = rs_candidate_head(uv, t1, j, kinds, RS_LIGHT_EMISSION, vec2(0.0f), 0u);
           keep = j;
@@ -446,7 +446,7 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
 #if PLUME_RS_LIGHT_CANDIDATES > 1
       // L light samples resampled by their unshadowed term (bridge.glsl)
       RsLightRay lightRay;
-      float wLight = rs_resample_light(vx, f, rng, light, ls, prim, lightRay);
+      float wLight = rs_resample_light(vx, f, D.k, rng, light, ls, prim, lightRay);
       float uSelect = rng_float(rng);
 #else
       uvec4 h = rng_next4(rng);
@@ -463,10 +463,10 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
         // selection was blind to visibility, and a kept path that turned out blocked left the
         // reservoir empty: on the city a moving frame's relMSE -20 to -24% with it, for +10% time
         // (notes/city.md "Session 37").
-        float ph = rs_luminance(f * lightRay.value) * rs_target_light_tr(VOL_CURRENT, lightRay);
+        float ph = rs_weigh(D.k, f * lightRay.value) * rs_target_light_tr(VOL_CURRENT, lightRay);
         if (ph > 0.0f && surf_occluded(lightRay.o, lightRay.w, lightRay.reach)) ph = 0.0f;
 #else
-        float ph = rs_luminance(f * rs_light_term(VOL_CURRENT, vx, light, ls, prim, false, rng));
+        float ph = rs_weigh(D.k, f * rs_light_term(VOL_CURRENT, vx, light, ls, prim, false, rng));
 #endif
         float weight = invM * ph * wLight / pdf;
         if (rs_update(r, weight, ph, 0.0f, uSelect)) {

@@ -78,10 +78,12 @@ RsTail rs_tail_start(RsDomain D, vec3 shaded, inout RngState rng) {
 // surfaces the segment ends at the nearer of the medium's collision and the first surface, a
 // vertex either way; NEE at either, BSDF sampling at a surface (weight f cos / pdf), and emitters
 // reached both ways with the reservoirs' MIS weights (rs_emitter_weight).
-bool rs_tail_segment(inout RsTail s, inout RngState rng) {
+// lightFrom, emissionFrom: the vertices after which it takes light samples and gathers emission
+// (final shading's tail: those the reservoirs do not hold; restir/colour.glsl's estimate: 0, 0).
+bool rs_tail_segment(inout RsTail s, inout RngState rng, uint lightFrom, uint emissionFrom) {
   uint j = s.j;
 #ifdef RS_ENDS_IN_EMISSION
-  uint emitting = rs_emission_vertices();
+  uint emitting = emissionFrom;
   uint segments = frame.maxBounces + 1u;
 #else
   uint segments = frame.maxBounces;
@@ -103,7 +105,7 @@ bool rs_tail_segment(inout RsTail s, inout RngState rng) {
   if (j > frame.maxBounces) return false;
 #endif
   PathVertex vx = path_vertex(seg, s.x, s.w, s.beta);
-  if (j > rsp.prefixVertices) {
+  if (j > lightFrom) {
     uvec4 h = rng_next4(rng);
     uint light;
     vec2 ls;
@@ -130,8 +132,13 @@ bool rs_tail_segment(inout RsTail s, inout RngState rng) {
 
 // At most RS_TAIL_SEGMENTS segments of the walk; true when it has ended.
 bool rs_tail_advance(inout RsTail s, inout RngState rng) {
+#ifdef RS_ENDS_IN_EMISSION
+  uint emissionFrom = rs_emission_vertices();
+#else
+  uint emissionFrom = 0u;
+#endif
   for (uint n = 0u; n < RS_TAIL_SEGMENTS; ++n) {
-    if (!rs_tail_segment(s, rng)) {
+    if (!rs_tail_segment(s, rng, rsp.prefixVertices, emissionFrom)) {
       s.j = 0u;
       return true;
     }
@@ -151,7 +158,7 @@ vec3 rs_shade(RsDomain D, uint pixelIndex, uint set, inout RngState rng) {
     float est;
     float mis;
     vec3 f = rs_path_contribution(D, set, pixelIndex, true, rng, est, mis);
-    float lum = rs_luminance(f);
+    float lum = rs_weigh(D.k, f);
     if (lum > 0.0f) L += (r.W * r.p_hat / lum) * est * mis * f;
   }
 #ifdef PLUME_HAS_EMITTERS

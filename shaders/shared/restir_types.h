@@ -53,7 +53,13 @@ const uint RS_SETS = 3u;
 // vec4s per pixel of a pass's state between its dispatches (restir/bridge.glsl rs_state_slot):
 // the candidates' running reservoir (1), the tail's walk (5, restir/shade.glsl RsTail).
 const uint RS_STATE_SLOTS = 5u;
-// vec4s per pixel of the lamp reservoirs (RestirParams::lampSet) past the state, with emissive
+// vec4s per pixel of the targets' colour weights past the state (RestirParams::colourSet;
+// restir/bridge.glsl rs_colour_slot): the weights of two sets (the current frame's and the
+// history's, which its domain keeps until its reservoirs are gone), then the estimate of the
+// pixel's radiance they come from (RS_COLOUR_ESTIMATE; restir/colour.glsl).
+const uint RS_COLOUR_SLOTS = 3u;
+const uint RS_COLOUR_ESTIMATE = 2u;
+// vec4s per pixel of the lamp reservoirs (RestirParams::lampSet) past the colour weights, with emissive
 // surfaces only: (W, M, packed (u, v), p̂) of each of the two sets (restir/bridge.glsl rs_lamp_slot).
 const uint RS_LAMP_SLOTS = 2u;
 // rsCounters[] (restir/bindings.glsl): [0] reservoirs dropped for non-finite weights,
@@ -114,8 +120,10 @@ struct RestirParams {
   uint lampSet;             // this frame's set (the history's is the other)
   uint lampHistory;         // 1: the other set holds the previous frame's, same pixel (a still camera)
   uint lampSameVolume;      // 1: ... rendered with this frame's volume (its target is this frame's)
-  uint pad0;
-  uint pad1;
+  // The targets' colour weights (restir/colour.glsl): the slot of this frame's and of the
+  // history's (the same slot where they did not change since the previous frame).
+  uint colourSet;
+  uint colourHistorySet;
   uint pad2;
 };
 
@@ -130,7 +138,7 @@ struct RsPush {
   uint countAlive;           // tail: 1 counts the walks still alive after this dispatch
   uint listBegin;            // the dispatch's pixels: rsPixels[listBegin .. listBegin + listCount)
   uint listCount;            //   (restir/bindings.glsl rs_dispatch_pixel)
-  uint pad2;
+  uint colourStep;           // colour weights (passes/restir_colour.comp): 0 / 1 a new estimate / one more, 2 the weights
 };
 
 // --- Light sample encoding: a unit direction as (z, phi), exact enough for float storage ---

@@ -16,6 +16,7 @@ const uint RNG_STREAM_CANDIDATES = 3u;
 const uint RNG_STREAM_TEMPORAL = 4u;
 const uint RNG_STREAM_SPATIAL = 5u;
 const uint RNG_STREAM_SHADING = 6u;
+const uint RNG_STREAM_COLOUR = 7u;  // ReSTIR's colour weights' own walks (restir/colour.glsl)
 const uint RNG_STREAM_TEST = 100u;
 
 struct RngState {

@@ -134,6 +134,7 @@ RenderSettings withRestir(RenderSettings rs, const RestirOptions& v) {
   rs.restirLightCandidates = v.lightCandidates;
   rs.restirLightCandidatesMoving = v.lightCandidatesMoving;
   rs.restirShift = v.reconnect ? "reconnect" : "copy";
+  rs.restirTarget = v.colourTarget ? "colour" : "luminance";
   return rs;
 }
 

@@ -25,7 +25,7 @@ std::string RestirOptions::name() const {
                         (historyCapStatic == RestirOptions{}.historyCapStatic ? "" : strf(" cs%d", historyCapStatic)) +
                         (candidatesMoving == RestirOptions{}.candidatesMoving ? "" : strf(" Mm%d", candidatesMoving)) +
                         (roundsStatic == RestirOptions{}.roundsStatic ? "" : strf(" Rs%d", roundsStatic)) +
-                        (reconnect ? "" : " copy") +
+                        (reconnect ? "" : " copy") + (colourTarget ? "" : " lum") +
                         (fixedNeighbourX || fixedNeighbourY ? strf(" at(%d,%d)", fixedNeighbourX, fixedNeighbourY) : "");
   if (rounds == 0 && roundsStatic <= 0) return strf("restir %s M%d R0 c%d%s", kind, candidates, historyCap, k.c_str());
   return strf("restir %s M%d k%d r%d R%d c%d%s", kind, candidates, neighbours, radius, rounds, historyCap, k.c_str());
@@ -47,6 +47,7 @@ RestirOptions restirOptionsOf(const RenderSettings& rs) {
   o.lightCandidates = rs.restirLightCandidates;
   o.lightCandidatesMoving = rs.restirLightCandidatesMoving;
   o.reconnect = rs.restirShift != "copy";
+  o.colourTarget = rs.restirTarget != "luminance";
   return o;
 }
 
@@ -136,7 +137,8 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   // The vertices, the one array that grows with the bounces, go in a storage buffer instead where
   // the texel buffers cannot hold them and a storage buffer can (desktop GPU drivers publish 2^27
   // texels, as lavapipe, and 2-4 GiB storage buffers: 3840x2160 at 8 bounces needs 174 M texels).
-  const size_t stateTexels = shared::RS_STATE_SLOTS + (features_.emitters ? shared::RS_LAMP_SLOTS : 0);
+  const size_t stateTexels =
+      shared::RS_STATE_SLOTS + shared::RS_COLOUR_SLOTS + (features_.emitters ? shared::RS_LAMP_SLOTS : 0);
   const size_t pixels = size_t(scene.camera.width) * size_t(scene.camera.height);
   const uint32_t stride = uint32_t(std::max(1, vertices - 1));  // vertex slots per pixel and set
   const size_t vertexTexels = kSets * stride;                     // per pixel
@@ -213,6 +215,8 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
                                               uint32_t(sizeof(shared::RsPush)), name + variant, glm::uvec3(64, 1, 1));
   };
   candidates_ = make("passes/restir_candidates.comp", "restir candidates", {});
+  colour_ = make("passes/restir_colour.comp", "restir colour",
+                 {{"PLUME_RS_COLOUR_TARGET", options_.colourTarget ? "1" : "0"}});
   // Frames whose camera moved may resample another number of light samples a vertex: a per-frame
   // constant of the canonical reservoir's candidates, as their M is (fillFrame), so reuse stays
   // unbiased. A pipeline of its own (L is compiled in), with emissive surfaces only.
@@ -285,6 +289,7 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   output_ = gpu::Buffer(ctx, 2 * pixels * sizeof(glm::vec4), storage, "restir accumulation");
   counters_ = gpu::Buffer(ctx, shared::RS_COUNTERS * sizeof(uint32_t), storage, "restir counters");
   counters_.fillZero();
+  output_.fillZero();
   reservoirs_.fillZero();
   paths_.fillZero();
   for (gpu::ComputePass* p : passes()) {
@@ -341,7 +346,7 @@ void Restir::setVolumes(const GpuVolumeResources& current, const GpuVolumeResour
 
 std::vector<gpu::ComputePass*> Restir::passes() const {
   std::vector<gpu::ComputePass*> p = {candidates_.get(), temporal_.get(), temporalSame_.get(), spatial_.get(),
-                                      shade_.get()};
+                                      shade_.get(), colour_.get()};
   for (gpu::ComputePass* q : {candidatesMoving_.get(), candidatesOut_.get(), temporalOut_.get(), spatialOut_.get(),
                               shadeOut_.get(), tail_.get(), lamps_.get(), lampsRect_.get()}) {
     if (q) p.push_back(q);
@@ -379,6 +384,26 @@ void Restir::fillFrame(int frame, uint32_t sequence, uint32_t key) {
   if (history) params_.prevCamera = prevCam_;
   params_.historyValid = history ? 1u : 0u;
   params_.historySameDomain = history && still && sameVolume ? 1u : 0u;
+  // The targets' colour weights (restir/colour.glsl) change only in frames where the history's
+  // domain is evaluated with its own: without a history, where the camera or the grid changed
+  // (the general temporal pipeline runs anyway), and in a still view after 1, 2, 4, ... 64 frames
+  // (the general pipeline once then, instead of the same-domain one, whose stored targets would be
+  // another function than the current one). Each change walks every pixel once more for the
+  // estimate they come from (~ one path-tracer sample).
+  ++colourAge_;
+  colourUpdate_ = !history || params_.historySameDomain == 0u || colourAge_ >= colourInterval_;
+  if (!options_.colourTarget) colourUpdate_ = !colourWritten_;  // grey, once
+  // Their estimate goes on averaging walks while camera and grid stay as they were (a frame
+  // without a history starts it over: it depends on nothing before it, docs/farm.md).
+  colourKeep_ = params_.historySameDomain != 0u;
+  params_.colourHistorySet = colourSet_;
+  if (colourUpdate_ && options_.colourTarget) {
+    colourSet_ ^= 1u;
+    colourInterval_ = params_.historySameDomain != 0u ? std::min(2u * colourInterval_, 64u) : 1u;
+    colourAge_ = 0;
+    params_.historySameDomain = 0u;
+  }
+  params_.colourSet = colourSet_;
   // The lamps seen directly (restir/candidates.glsl rs_lamp_reservoir): the sets alternate; the
   // history is the same pixel's only with a still camera.
   params_.lampSet ^= 1u;
@@ -549,6 +574,21 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
     };
     // walksPerDispatch candidate walks per dispatch (lavapipe's loop budget: restir/candidates.glsl);
     // the outside variant's M walks (none of them reaches a vertex) in one.
+    if (colourUpdate_) {
+      const uint32_t colourScope = timer_.begin(cmd, "restir colour");
+      shared::RsPush colourPush = push;
+      colourPush.colourStep = colourKeep_ ? 1u : 0u;
+      if (options_.colourTarget) {
+        over(*colour_, colourPush, 0, all);
+        gpu::computeBarrier(cmd);
+      }
+      colourPush.colourStep = 2u;
+      over(*colour_, colourPush, 0, all);
+      colourWritten_ = true;
+      timer_.end(cmd, colourScope);
+      labels.push_back("colour");
+      gpu::computeBarrier(cmd);
+    }
     if (lamps_) {  // (its pixels' lamp reservoirs; the candidates pass writes the others')
       const uint32_t lampScope = timer_.begin(cmd, "restir lamps");
       const uint32_t listBegin = all + (all + 31) / 32;

@@ -46,6 +46,8 @@ struct RestirOptions {
   int lightCandidatesMoving = 0;  // L while the camera moves (0: lightCandidates)
   bool reconnect = true;     // the reconnection shift at the first surface vertex after the primary
                              // (false: the copy shift; shared/restir_types.h)
+  bool colourTarget = true;  // each pixel's target weighs the channels by its estimated colour
+                             // (restir/colour.glsl; false: the luminance)
   // Tests only (no scene setting): when not (0, 0), every spatial round reuses exactly one
   // neighbour, the pixel at this offset, instead of k drawn in the disk. Unbiased (the choice does
   // not depend on the samples), but the offset is never mirrored, so an error of the shift that is
@@ -143,6 +145,15 @@ class Restir {
   std::unique_ptr<GpuSurfaces> surfaces_;  // only for a scene with surfaces
   std::unique_ptr<gpu::ComputePass> candidates_, temporal_, temporalSame_, spatial_, shade_;
   std::unique_ptr<gpu::ComputePass> candidatesMoving_;  // with lightCandidatesMoving (null: candidates_ serves)
+  std::unique_ptr<gpu::ComputePass> colour_;  // the targets' colour weights (passes/restir_colour.comp)
+  // The colour weights (restir/colour.glsl): this frame's slot, whether this frame writes it, the
+  // frames since they last changed and how many until they change again in a still view.
+  uint32_t colourSet_ = 0;
+  bool colourUpdate_ = false;
+  bool colourWritten_ = false;  // the weights were written once (luminance: grey, once)
+  bool colourKeep_ = false;  // this frame's walks for them add to the estimate (camera and grid still)
+  uint32_t colourAge_ = 0;
+  uint32_t colourInterval_ = 1;
   bool moved_ = false;  // this frame's camera moved since the previous frame of the sequence (fillFrame)
   std::unique_ptr<gpu::ComputePass> lamps_;  // the lamps seen directly (only with emissive surfaces)
   std::unique_ptr<gpu::ComputePass> lampsRect_;  // with pieces, for the pixels whose pieces do not fit

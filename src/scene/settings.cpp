@@ -85,6 +85,12 @@ const std::vector<SettingDesc>& renderSettingsTable() {
        "direction is copied; each surface vertex is wherever the copied ray lands). Both unbiased; scenes "
        "without surfaces are unaffected",
        &RenderSettings::restirShift, 0, 0, {"reconnect", "copy"}},
+      {"restir_target",
+       "ReSTIR: the scalar its resampling weighs a path's RGB contribution by: colour (each channel divided by "
+       "the pixel's own colour as the earlier frames estimated it, so that a pixel's rare paths of another "
+       "colour, a fire's sky light, a street's cold lamp, weigh by their share of that channel) or luminance "
+       "(the channels' mean). Both unbiased (notes/restir.md \"Session 39\")",
+       &RenderSettings::restirTarget, 0, 0, {"colour", "luminance"}},
       {"restir_prefix",
        "ReSTIR: scattering vertices a reservoir's path holds (1-16, shared::RS_MAX_VERTICES); paths with more "
        "(up to max_bounces) are path traced in final shading",

@@ -41,6 +41,7 @@ struct RenderSettings {
   int restirLightCandidates = 2;     // light samples resampled at each candidate vertex (RIS)
   int restirLightCandidatesMoving = 0;  // ... in frames whose camera moved (0: restirLightCandidates)
   std::string restirShift = "reconnect";  // reconnect (at the first surface vertex after the primary) | copy
+  std::string restirTarget = "colour";    // colour (each pixel's channels weighed by its colour) | luminance
 };
 
 struct SettingDesc {
