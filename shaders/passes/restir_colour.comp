@@ -1,7 +1,8 @@
 // ReSTIR's colour weights (restir/colour.glsl), in the frames where they change
-// (Restir::fillFrame), before the candidates: push.colourStep 0 or 1 walks each pixel's
-// estimate (1: into the mean of the earlier ones), 2 writes the weights of slot rsp.colourSet
-// from the estimates (a dispatch of its own: it reads the neighbours').
+// (Restir::fillFrame), before the candidates: push.colourStep 0, 1 or 3 walks each pixel's
+// estimate (0: afresh; 1: into the mean of the walks since the camera and the grid last changed;
+// 3: of the last few, while the camera moves), 2 writes the weights of slot rsp.colourSet from
+// the estimates (a dispatch of its own: it reads the neighbours').
 #version 450
 #extension GL_GOOGLE_include_directive : require
 
@@ -23,7 +24,7 @@ void main() {
     rs_set_state(rs_colour_slot(rsp.colourSet, index), vec4(rs_colour_weights(pixel), 0.0f));
   } else {
 #if PLUME_RS_COLOUR_TARGET
-    rs_colour_estimate(pixel, index, push.colourStep == 1u);
+    rs_colour_estimate(pixel, index, push.colourStep == 0u ? 0.0f : push.colourStep == 1u ? 1e6f : 3.0f);
 #endif
   }
   loop_guard_check(frame.loopProbe);

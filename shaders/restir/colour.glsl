@@ -29,18 +29,18 @@
 #define RS_COLOUR_FLOOR (1.0f / 16.0f)
 #endif
 
-// One walk's estimate of the pixel's radiance, into the pixel's estimate slot: its mean so far
-// (keep: over the walks since the camera or the grid last changed) or this walk alone.
-void rs_colour_estimate(uvec2 pixel, uint index, bool keep) {
+// One walk's estimate of the pixel's radiance, into the pixel's estimate slot: the mean of the
+// last `memory` walks' (about: a running mean whose count stops there; 0: this walk alone).
+void rs_colour_estimate(uvec2 pixel, uint index, float memory) {
   RngState rng = rng_init(pixel, frame.frameKey, RNG_STREAM_COLOUR, frame.seed);
   RsTail s = rs_tail_start(rs_current_domain(pixel), vec3(0.0f), rng);
   for (uint n = 0u; n < RS_TAIL_SEGMENTS; ++n) {
-    if (!rs_tail_segment(s, rng, 0u, 0u)) break;
+    if (!rs_tail_segment(s, rng, 0u, 0u, false)) break;
   }
   vec3 L = rs_is_finite(s.L.x + s.L.y + s.L.z) ? max(s.L, vec3(0.0f)) : vec3(0.0f);
   uint slot = rs_colour_slot(RS_COLOUR_ESTIMATE, index);
-  vec4 e = keep ? rs_state(slot) : vec4(0.0f);
-  float n = e.w + 1.0f;
+  vec4 e = memory > 0.0f ? rs_state(slot) : vec4(0.0f);
+  float n = min(e.w, memory) + 1.0f;
   rs_set_state(slot, vec4(e.rgb + (L - e.rgb) / n, n));
 }
 

@@ -79,8 +79,10 @@ RsTail rs_tail_start(RsDomain D, vec3 shaded, inout RngState rng) {
 // vertex either way; NEE at either, BSDF sampling at a surface (weight f cos / pdf), and emitters
 // reached both ways with the reservoirs' MIS weights (rs_emitter_weight).
 // lightFrom, emissionFrom: the vertices after which it takes light samples and gathers emission
-// (final shading's tail: those the reservoirs do not hold; restir/colour.glsl's estimate: 0, 0).
-bool rs_tail_segment(inout RsTail s, inout RngState rng, uint lightFrom, uint emissionFrom) {
+// (final shading's tail: those the reservoirs do not hold; restir/colour.glsl's estimate: 0, 0);
+// unbiased: the light rays' transmittance by residual ratio tracking (the tail's) or the target's
+// midpoint rule (the colour estimate's: any function of the walk serves it, and the cheap one).
+bool rs_tail_segment(inout RsTail s, inout RngState rng, uint lightFrom, uint emissionFrom, bool unbiased) {
   uint j = s.j;
 #ifdef RS_ENDS_IN_EMISSION
   uint emitting = emissionFrom;
@@ -111,7 +113,7 @@ bool rs_tail_segment(inout RsTail s, inout RngState rng, uint lightFrom, uint em
     vec2 ls;
     uint prim;
     float pl = rs_sample_light(vx, vec3(rng_to_float(h.x), rng_to_float(h.y), rng_to_float(h.z)), rng, light, ls, prim);
-    if (pl > 0.0f) s.L += s.beta * rs_light_term(VOL_CURRENT, vx, light, ls, prim, true, rng) / pl;
+    if (pl > 0.0f) s.L += s.beta * rs_light_term(VOL_CURRENT, vx, light, ls, prim, unbiased, rng) / pl;
   }
   if (j == segments) return false;
   // The candidates' roulette: on the albedo, not the throughput.
@@ -138,7 +140,7 @@ bool rs_tail_advance(inout RsTail s, inout RngState rng) {
   uint emissionFrom = 0u;
 #endif
   for (uint n = 0u; n < RS_TAIL_SEGMENTS; ++n) {
-    if (!rs_tail_segment(s, rng, rsp.prefixVertices, emissionFrom)) {
+    if (!rs_tail_segment(s, rng, rsp.prefixVertices, emissionFrom, true)) {
       s.j = 0u;
       return true;
     }

@@ -390,16 +390,29 @@ void Restir::fillFrame(int frame, uint32_t sequence, uint32_t key) {
   // (the general pipeline once then, instead of the same-domain one, whose stored targets would be
   // another function than the current one). Each change walks every pixel once more for the
   // estimate they come from (~ one path-tracer sample).
+  // While the camera or the grid changes, every kColourMovingInterval frames (each change walks
+  // every pixel once, ~ one path-tracer sample: the weights of a pixel a few frames old serve as
+  // well as any).
+  constexpr uint32_t kColourMovingInterval = 4;
+  const bool sameDomain = params_.historySameDomain != 0u;
   ++colourAge_;
-  colourUpdate_ = !history || params_.historySameDomain == 0u || colourAge_ >= colourInterval_;
+  if (!history) {
+    colourUpdate_ = true;
+  } else if (sameDomain) {
+    if (!colourStill_) colourInterval_ = 1;  // the first still frame: 1, 2, 4, ... from here
+    colourUpdate_ = colourAge_ >= colourInterval_;
+  } else {
+    colourUpdate_ = colourAge_ >= kColourMovingInterval;
+  }
+  colourStill_ = history && sameDomain;
   if (!options_.colourTarget) colourUpdate_ = !colourWritten_;  // grey, once
-  // Their estimate goes on averaging walks while camera and grid stay as they were (a frame
-  // without a history starts it over: it depends on nothing before it, docs/farm.md).
-  colourKeep_ = params_.historySameDomain != 0u;
+  // Their estimate: a frame without a history starts it over (it depends on nothing before it,
+  // docs/farm.md); a still view averages every walk since it stood still, a moving one the last few.
+  colourStep_ = !history ? 0u : sameDomain ? 1u : 3u;
   params_.colourHistorySet = colourSet_;
   if (colourUpdate_ && options_.colourTarget) {
     colourSet_ ^= 1u;
-    colourInterval_ = params_.historySameDomain != 0u ? std::min(2u * colourInterval_, 64u) : 1u;
+    if (sameDomain) colourInterval_ = std::min(2u * colourInterval_, 64u);
     colourAge_ = 0;
     params_.historySameDomain = 0u;
   }
@@ -577,7 +590,7 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
     if (colourUpdate_) {
       const uint32_t colourScope = timer_.begin(cmd, "restir colour");
       shared::RsPush colourPush = push;
-      colourPush.colourStep = colourKeep_ ? 1u : 0u;
+      colourPush.colourStep = colourStep_;
       if (options_.colourTarget) {
         over(*colour_, colourPush, 0, all);
         gpu::computeBarrier(cmd);

@@ -151,7 +151,8 @@ class Restir {
   uint32_t colourSet_ = 0;
   bool colourUpdate_ = false;
   bool colourWritten_ = false;  // the weights were written once (luminance: grey, once)
-  bool colourKeep_ = false;  // this frame's walks for them add to the estimate (camera and grid still)
+  uint32_t colourStep_ = 0;  // how this frame's walks enter their estimate (passes/restir_colour.comp)
+  bool colourStill_ = false;  // the previous frame was a still one (its history in its domain)
   uint32_t colourAge_ = 0;
   uint32_t colourInterval_ = 1;
   bool moved_ = false;  // this frame's camera moved since the previous frame of the sequence (fillFrame)
