@@ -138,7 +138,7 @@ struct RsPush {
   uint countAlive;           // tail: 1 counts the walks still alive after this dispatch
   uint listBegin;            // the dispatch's pixels: rsPixels[listBegin .. listBegin + listCount)
   uint listCount;            //   (restir/bindings.glsl rs_dispatch_pixel)
-  uint colourStep;           // colour weights (passes/restir_colour.comp): 0 / 1 a new estimate / one more, 2 the weights
+  uint colourStep;           // colour weights (passes/restir_colour.comp): 0 / 1 / 3 a walk into the estimate, 2 the weights
 };
 
 // --- Light sample encoding: a unit direction as (z, phi), exact enough for float storage ---

@@ -385,14 +385,13 @@ void Restir::fillFrame(int frame, uint32_t sequence, uint32_t key) {
   params_.historyValid = history ? 1u : 0u;
   params_.historySameDomain = history && still && sameVolume ? 1u : 0u;
   // The targets' colour weights (restir/colour.glsl) change only in frames where the history's
-  // domain is evaluated with its own: without a history, where the camera or the grid changed
-  // (the general temporal pipeline runs anyway), and in a still view after 1, 2, 4, ... 64 frames
-  // (the general pipeline once then, instead of the same-domain one, whose stored targets would be
-  // another function than the current one). Each change walks every pixel once more for the
-  // estimate they come from (~ one path-tracer sample).
-  // While the camera or the grid changes, every kColourMovingInterval frames (each change walks
-  // every pixel once, ~ one path-tracer sample: the weights of a pixel a few frames old serve as
-  // well as any).
+  // domain is evaluated with its own weights: without a history (every frame with
+  // restir_history_cap 0), every kColourMovingInterval-th frame while the camera or the grid
+  // changes (the general temporal pipeline runs anyway; weights a few frames old serve as well as
+  // any), and in a still view after 1, 2, 4, ... 64 frames, then every 64 (the general pipeline
+  // once then, instead of the same-domain one, whose stored targets would be another function than
+  // the current one). Each change walks every pixel once for the estimate they come from (about
+  // one path-tracer sample: restir/colour.glsl).
   constexpr uint32_t kColourMovingInterval = 4;
   const bool sameDomain = params_.historySameDomain != 0u;
   ++colourAge_;
