@@ -350,16 +350,16 @@ TEST_F(GpuRestir, MovingCameraMatchesReferencesOfItsPoses) {
 }
 
 // The targets' colour weights (restir/colour.glsl, render.restir_target colour, the default):
-// each pixel's target weighs the channels by the inverse of its colour as the earlier frames
-// estimated it, and the weights change only in frames where the general temporal pipeline runs.
+// each pixel's target weighs the channels by the inverse of its colour as walks of its own
+// estimate it, and the weights change only in frames where the general temporal pipeline runs.
 // Under an orange sun and a blue sky (pixels of very different colours), over frames whose camera
-// moves (the weights change every frame; the history's domain keeps its own) and then stands still
-// (they change once more, at the first still frame, then stay: the same-domain pipeline), the
-// image must match the reference of the last pose; and it must differ from the luminance
-// target's in most lit pixels, with the same random numbers (the weights act: grey weights give
-// the luminance's image bit for bit, both being dot(k, f)).
+// moves (the weights change in the 4th frame after the first, while it moves: the history's domain
+// keeps its own) and then stands still (they change once more, at the first still frame, then
+// stay: the same-domain pipeline), the image must match the reference of the last pose; and it
+// must differ from the luminance target's in most lit pixels, with the same random numbers (the
+// weights act: grey weights give the luminance's image bit for bit, both being dot(k, f)).
 TEST_F(GpuRestir, ColourTargetUnderColouredLightsMatchesReference) {
-  Scene s = movedBy(baseScene(16), 3, {1.6f, 1.3f, 3.4f});
+  Scene s = movedBy(baseScene(16), 6, {1.6f, 1.3f, 3.4f});
   s.lights = {test::sunLight({0.4f, 1.0f, 0.3f}, {4.0f, 1.6f, 0.3f}), test::skyLight({0.04f, 0.10f, 0.45f})};
   s.render.maxBounces = 2;
   auto grid = test::makeNoiseGrid(40, 1.0 / 20, 2);
@@ -369,9 +369,22 @@ TEST_F(GpuRestir, ColourTargetUnderColouredLightsMatchesReference) {
   RestirOptions luminance = colour;
   luminance.colourTarget = false;
   RunSpec spec;
-  spec.framesPerRun = 5;  // frames 2-3 move, 4 is the first still frame, 5 keeps its weights
+  // Weights change in frames 1 (grey), 5 (moving: frames 2-6 move) and 7 (the first still frame).
+  spec.framesPerRun = 7;
   RestirRun run = runRestir(ctx(), compiler(), s, colour, spec, [&](int) { return grid; });
-  expectMatches(run, reference(s, grid, 512, 5), "colour_target");
+  expectMatches(run, reference(s, grid, 512, 7), "colour_target");
+  // Weights that change in every moving frame (frames 2-5 move), between two fixed sets far apart
+  // (RestirOptions::colourAlternate): each frame's history's domain must be evaluated with the
+  // history's weights (notes/session-39-closing-note.md has what the current ones read).
+  Scene m = s;
+  m.camera.keys.back().frame = 5;
+  RunSpec moving = spec;
+  moving.framesPerRun = 5;
+  RestirOptions everyFrame = colour;
+  everyFrame.colourMovingInterval = 1;
+  everyFrame.colourAlternate = true;
+  RestirRun runMoving = runRestir(ctx(), compiler(), m, everyFrame, moving, [&](int) { return grid; });
+  expectMatches(runMoving, reference(m, grid, 512, 5), "colour_target_moving");
   RunSpec two = spec;
   two.runs = 2;
   const Image a = runRestir(ctx(), compiler(), s, colour, two, [&](int) { return grid; }).mean;

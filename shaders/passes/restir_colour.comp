@@ -21,7 +21,11 @@ void main() {
   if (!rs_dispatch_pixel(pixel)) return;
   uint index = pixel.y * frame.size.x + pixel.x;
   if (push.colourStep == 2u) {
-    rs_set_state(rs_colour_slot(rsp.colourSet, index), vec4(rs_colour_weights(pixel), 0.0f));
+    vec3 k = rs_colour_weights(pixel);
+#if PLUME_RS_COLOUR_ALTERNATE  // tests only (RestirOptions::colourAlternate)
+    k = rsp.colourSet == 0u ? vec3(0.5f, 0.3f, 0.2f) : vec3(0.2f, 0.3f, 0.5f);
+#endif
+    rs_set_state(rs_colour_slot(rsp.colourSet, index), vec4(k, 0.0f));
   } else {
 #if PLUME_RS_COLOUR_TARGET
     rs_colour_estimate(pixel, index, push.colourStep == 0u ? 0.0f : push.colourStep == 1u ? 1e6f : 3.0f);

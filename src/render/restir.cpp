@@ -216,7 +216,8 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   };
   candidates_ = make("passes/restir_candidates.comp", "restir candidates", {});
   colour_ = make("passes/restir_colour.comp", "restir colour",
-                 {{"PLUME_RS_COLOUR_TARGET", options_.colourTarget ? "1" : "0"}});
+                 {{"PLUME_RS_COLOUR_TARGET", options_.colourTarget ? "1" : "0"},
+                  {"PLUME_RS_COLOUR_ALTERNATE", options_.colourAlternate ? "1" : "0"}});
   // Frames whose camera moved may resample another number of light samples a vertex: a per-frame
   // constant of the canonical reservoir's candidates, as their M is (fillFrame), so reuse stays
   // unbiased. A pipeline of its own (L is compiled in), with emissive surfaces only.
@@ -386,13 +387,12 @@ void Restir::fillFrame(int frame, uint32_t sequence, uint32_t key) {
   params_.historySameDomain = history && still && sameVolume ? 1u : 0u;
   // The targets' colour weights (restir/colour.glsl) change only in frames where the history's
   // domain is evaluated with its own weights: without a history (every frame with
-  // restir_history_cap 0), every kColourMovingInterval-th frame while the camera or the grid
+  // restir_history_cap 0), every 4th frame (options_.colourMovingInterval) while the camera or the grid
   // changes (the general temporal pipeline runs anyway; weights a few frames old serve as well as
   // any), and in a still view after 1, 2, 4, ... 64 frames, then every 64 (the general pipeline
   // once then, instead of the same-domain one, whose stored targets would be another function than
   // the current one). Each change walks every pixel once for the estimate they come from (about
   // one path-tracer sample: restir/colour.glsl).
-  constexpr uint32_t kColourMovingInterval = 4;
   const bool sameDomain = params_.historySameDomain != 0u;
   ++colourAge_;
   if (!history) {
@@ -401,7 +401,7 @@ void Restir::fillFrame(int frame, uint32_t sequence, uint32_t key) {
     if (!colourStill_) colourInterval_ = 1;  // the first still frame: 1, 2, 4, ... from here
     colourUpdate_ = colourAge_ >= colourInterval_;
   } else {
-    colourUpdate_ = colourAge_ >= kColourMovingInterval;
+    colourUpdate_ = colourAge_ >= uint32_t(std::max(1, options_.colourMovingInterval));
   }
   colourStill_ = history && sameDomain;
   if (!options_.colourTarget) colourUpdate_ = !colourWritten_;  // grey, once

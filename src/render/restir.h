@@ -48,6 +48,14 @@ struct RestirOptions {
                              // (false: the copy shift; shared/restir_types.h)
   bool colourTarget = true;  // each pixel's target weighs the channels by its estimated colour
                              // (restir/colour.glsl; false: the luminance)
+  // Tests only: the colour weights change every this many frames while the camera or the grid
+  // moves (Restir::fillFrame); 1 makes every moving frame one whose history's domain keeps the
+  // weights it had, which is what the Z-test must see often enough to resolve a mistake there.
+  int colourMovingInterval = 4;
+  // Tests only: the weights of each slot fixed and far apart ((5, 3, 2) / 10 and (2, 3, 5) / 10)
+  // instead of estimated, so that a domain evaluated with the other slot's weights is a bias a
+  // Z-test resolves (estimated weights change little from one change to the next).
+  bool colourAlternate = false;
   // Tests only (no scene setting): when not (0, 0), every spatial round reuses exactly one
   // neighbour, the pixel at this offset, instead of k drawn in the disk. Unbiased (the choice does
   // not depend on the samples), but the offset is never mirrored, so an error of the shift that is
