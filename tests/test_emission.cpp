@@ -332,6 +332,53 @@ TEST_F(GpuEmission, RestirTemporalSpatialGbhBlackbodyMatchesReference) {
   compareRestir(ctx(), compiler(), restirCloud(true), o, 3, 4096, "restir_temporal_gbh_blackbody");
 }
 
+// The emission's reservoir of its own (render.restir_emission_reservoir own, the default with an
+// emitting medium and lights; restir/bridge.glsl PLUME_RS_CLASSES): the paths that end in the
+// medium's emission are resampled and reused apart from those that end at a light, and final
+// shading adds the two. An orange blackbody cloud under a blue sky and a white sun, so that the
+// two classes differ in colour; 40 candidates a pixel, so the candidates pass pauses and resumes
+// both reservoirs across three dispatches (64 vertices a dispatch, walks of 4); temporal reuse
+// over three frames and spatial reuse.
+TEST_F(GpuEmission, RestirEmissionReservoirOfItsOwnMatchesReference) {
+  Scene s = restirCloud(true);
+  s.lights.push_back(test::skyLight({0.05f, 0.12f, 0.35f}));
+  RestirOptions o;
+  o.candidates = 40;
+  o.historyCap = 2;
+  o.radius = 6;
+  {
+    auto density = test::makeNoiseGrid(40, 1.0 / 20, 3);
+    LoadedGrid d = wrap(density, "density");
+    BakedVolume bake = bakeVolume(d);
+    bakeEmission(bake, d, wrap(test::makeNoiseGrid(40, 1.0 / 20, 8), "emission"));
+    GpuVolumeResources volume(ctx(), bake, s.medium().densityScale, &*s.medium().emission);
+    // The split is what runs (two classes), and it changes the frames: one reservoir for both
+    // (shared) gives other images from the same random numbers.
+    Restir own(ctx(), compiler(), s, o);
+    RestirOptions one = o;
+    one.emissionReservoir = false;
+    Restir shared(ctx(), compiler(), s, one);
+    EXPECT_EQ(own.classes(), 2u);
+    EXPECT_EQ(shared.classes(), 1u);
+    own.setVolumes(volume, volume);
+    shared.setVolumes(volume, volume);
+    Image a, b;
+    for (int f = 1; f <= 3; ++f) {
+      a = own.renderFrame(f);
+      b = shared.renderFrame(f);
+    }
+    int differ = 0;
+    for (int y = 0; y < a.height; ++y)
+      for (int x = 0; x < a.width; ++x) differ += a.pixel(x, y) != b.pixel(x, y) ? 1 : 0;
+    EXPECT_GT(differ, a.width * a.height / 4);
+    // Without a light there is nothing to split: one class.
+    Scene dark = s;
+    dark.lights.clear();
+    EXPECT_EQ(Restir(ctx(), compiler(), dark, o).classes(), 1u);
+  }
+  compareRestir(ctx(), compiler(), s, o, 3, 4096, "restir_emission_reservoir");
+}
+
 }  // namespace
 
 namespace {

@@ -15,6 +15,14 @@
 #ifndef PLUME_RS_LIGHT_CANDIDATES
 #define PLUME_RS_LIGHT_CANDIDATES 1  // light samples resampled at a candidate vertex (render/restir.cpp)
 #endif
+// Reservoirs per pixel and set: 1, or 2 where an emitting medium's paths that end in its emission
+// have a reservoir of their own (RS_CLASS_EMISSION, in set s) beside the paths that end at a light
+// (RS_CLASS_LIGHT, in set s + RS_SETS): render.restir_emission_reservoir, render/restir.cpp. The
+// two classes split the path space, so their estimates add; a pixel's one selected path no longer
+// carries the colour of whichever end won (the fire's orange emission against the sky's blue).
+#ifndef PLUME_RS_CLASSES
+#define PLUME_RS_CLASSES 1
+#endif
 
 // A domain of the integral: one pixel of one frame (its camera and that frame's volume). The
 // pixel's box filter is part of the path: a path starts with its position (u, v) in [0, 1]² inside
@@ -328,14 +336,15 @@ void rs_store_head(uint set, uint pixelIndex, RsPathHead h) {
 // A pixel's state between the dispatches of one pass (RS_STATE_SLOTS texels past the path heads,
 // rs_state / rs_set_state): the candidates' running reservoir (restir/candidates.glsl), then final
 // shading's tail (restir/shade.glsl).
-uint rs_state_slot(uint pixelIndex) { return 2u * RS_SETS * rsp.pixelCount + RS_STATE_SLOTS * pixelIndex; }
+const uint RS_ALL_SETS = RS_SETS * uint(PLUME_RS_CLASSES);  // the sets of every class
+uint rs_state_slot(uint pixelIndex) { return 2u * RS_ALL_SETS * rsp.pixelCount + RS_STATE_SLOTS * pixelIndex; }
 // A pixel's colour weights of set `set` (RestirParams::colourSet), past the state.
 uint rs_colour_slot(uint set, uint pixelIndex) {
-  return (2u * RS_SETS + RS_STATE_SLOTS + set) * rsp.pixelCount + pixelIndex;
+  return (2u * RS_ALL_SETS + RS_STATE_SLOTS + set) * rsp.pixelCount + pixelIndex;
 }
 // A pixel's lamp reservoir of set `set` (RestirParams::lampSet), past the colour weights.
 uint rs_lamp_slot(uint set, uint pixelIndex) {
-  return (2u * RS_SETS + RS_STATE_SLOTS + RS_COLOUR_SLOTS + set) * rsp.pixelCount + pixelIndex;
+  return (2u * RS_ALL_SETS + RS_STATE_SLOTS + RS_COLOUR_SLOTS + set) * rsp.pixelCount + pixelIndex;
 }
 
 // Vertex count of the stored path (0: none), and marking a slot empty.

@@ -240,6 +240,62 @@ void rs_lamp_reservoir(RsDomain D, uint pixelIndex, RsReservoir r, uint uv, vec3
 void rs_lamp_skipped(uint pixelIndex) { rs_set_state(rs_lamp_slot(rsp.lampSet, pixelIndex), vec4(0.0f, 1.0f, 0.0f, 0.0f)); }
 #endif
 
+// A class's running reservoir at the end of a dispatch that leaves walks to the next one: w_sum,
+// the candidates' own target of the selected path and the random stream's position in the
+// pixel's state slot (slot + 1: the emission's, PLUME_RS_CLASSES 2), the selected path's head in its set.
+void rs_candidates_pause(uint slot, uint set, uint pixelIndex, RsReservoir r, RsPathHead head, uint counter, float segments) {
+  rs_set_state(slot, vec4(r.w_sum, r.p_hat, uintBitsToFloat(counter), segments));
+  rs_store_head(set, pixelIndex, head);
+}
+
+// A class's reservoir after the last walk, into set `set`: confidence M, the target of the
+// selected path and its contribution weight.
+void rs_candidates_finish(RsDomain D, uint set, uint pixelIndex, RsReservoir r, RsPathHead head, float segments, uint M) {
+  r.M = float(M);
+  rs_store_head(set, pixelIndex, head);
+#if PLUME_RS_LIGHT_CANDIDATES > 1
+  // The candidates' own target p̂' of light samples (rs_candidate_walks), so W = w_sum / p̂'(Y), p̂'(Y) the
+  // value rs_update kept for Y times the segments' transmittances that every weight left out
+  // (GRIS: any target of the candidates' own resampling that is positive wherever p̂ is gives an
+  // unbiased contribution weight). p̂' is the target without those transmittances (the light
+  // term with its visibility, the emitter hits' and the emission's terms alike), so the
+  // reservoir's p̂, the target of Y, is p̂'(Y) times them: gathered while the walk went
+  // (`segments`: the same mean-field transmittance of the same rays as rs_path_contribution's),
+  // where until session 38 the target was evaluated once more from the stored path, tracing its
+  // rays again (the city's still frames -2.4 ms of 13; reuse reads this value as the input's own
+  // target, so the two must agree: GpuRestirSurfaces.CandidatesTargetIsTheTargetReuseEvaluates).
+  // 0 where Y's light ray is blocked (p̂' is), and then the reservoir holds no path.
+  float target = head.vertexCount > 0u && r.w_sum > 0.0f ? r.p_hat * segments : 0.0f;
+  r.p_hat *= segments;
+  rs_finalize(r);
+  r.p_hat = target;
+  if (!(target > 0.0f)) r.W = 0.0f;
+#else
+#ifndef PLUME_RS_OUTSIDE
+  // The target of the selected path, with its transmittances (the weights' p̂ left them out).
+  r.p_hat = head.vertexCount > 0u && r.w_sum > 0.0f ? rs_target(D, set, pixelIndex) : 0.0f;
+#endif
+  rs_finalize(r);
+#endif
+  if (r.W <= 0.0f) rs_clear_path(set, pixelIndex);
+  rs_store(set, pixelIndex, r);
+}
+
+// The candidates that end in the medium's emission go to a reservoir of their own with two
+// classes (bridge.glsl PLUME_RS_CLASSES: rE, headE, ... in set outSet; the others in outSet +
+// RS_SETS), else to the one reservoir.
+#if PLUME_RS_CLASSES > 1
+#define RS_E_R rE
+#define RS_E_HEAD headE
+#define RS_E_KEEP keepE
+#define RS_E_SEGMENTS segmentsKeepE
+#else
+#define RS_E_R r
+#define RS_E_HEAD head
+#define RS_E_KEEP keep
+#define RS_E_SEGMENTS segmentsKeep
+#endif
+
 // Walks first .. first + rsp.walksPerDispatch - 1 (at most M - 1) of the pixel's M; the first
 // dispatch also writes the pixel's lamp reservoir where the lamp pass does not (rs_lamp_skipped).
 void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
@@ -265,31 +321,35 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
 #ifndef PLUME_HAS_SURFACES
   float q = min(1.0f, plume_max3(vtx_albedo(VERTEX_MEDIUM)));  // the roulette's (below)
 #endif
-  uint base = rs_bounce_base(outSet, pixelIndex);
+  // With two classes (PLUME_RS_CLASSES) r, head, keep hold the paths that end at a light, in set
+  // setL; rE, headE, keepE those that end in the medium's emission, in outSet.
+  uint setL = outSet + (PLUME_RS_CLASSES > 1 ? RS_SETS : 0u);
+  uint base = rs_bounce_base(setL, pixelIndex);
   RsReservoir r = rs_empty();
-  RsPathHead head;
-#if PLUME_RS_LIGHT_CANDIDATES > 1
+  RsPathHead head = rs_candidate_head(0u, 0.0f, 0u, 0u, 0u, vec2(0.0f), 0u);
   // The mean field's transmittance along the selected candidate's segments: the factor of its
-  // target that the weights leave out (see the end).
+  // target that the weights leave out with light resampling (rs_candidates_finish).
   float segmentsKeep = 0.0f;
+#if PLUME_RS_CLASSES > 1
+  uint baseE = rs_bounce_base(outSet, pixelIndex);
+  RsReservoir rE = rs_empty();
+  RsPathHead headE = head;
+  float segmentsKeepE = 0.0f;
 #endif
-  if (first == 0u) {
-    head.lightSample = vec2(0.0f);
-    head.t1 = 0.0f;
-    head.vertexCount = 0u;
-    head.light = 0u;
-    head.kinds = 0u;
-    head.uv = 0u;
-    head.lightPrim = 0u;
-  } else {  // the walks before this one
+  if (first != 0u) {  // the walks before this one
     vec4 state = rs_state(rs_state_slot(pixelIndex));
     r.w_sum = state.x;
     r.p_hat = state.y;  // the candidates' own target of the selected one
     rng.counter = floatBitsToUint(state.z);
-#if PLUME_RS_LIGHT_CANDIDATES > 1
     segmentsKeep = state.w;
+    head = rs_load_head(setL, pixelIndex);
+#if PLUME_RS_CLASSES > 1
+    state = rs_state(rs_state_slot(pixelIndex) + 1u);
+    rE.w_sum = state.x;
+    rE.p_hat = state.y;
+    segmentsKeepE = state.w;
+    headE = rs_load_head(outSet, pixelIndex);
 #endif
-    head = rs_load_head(outSet, pixelIndex);
   }
 #ifdef PLUME_HAS_EMITTERS
   // The lamp reservoir: the lamp pass's (passes/restir_lamps.comp), or empty; either way the
@@ -318,6 +378,9 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
   float pdf = 1.0f;     // exp(-tau_c) both hold (they cancel in the weights)
   float t1 = 0.0f;
   uint keep = 0u;   // vertices of this walk's selected candidate (0: none): copied when the walk ends
+#if PLUME_RS_CLASSES > 1
+  uint keepE = 0u;  // the same for the emission's reservoir
+#endif
   uint kinds = 0u;  // this walk's vertex kinds so far (RsPathHead.kinds)
 #if PLUME_RS_LIGHT_CANDIDATES > 1
   float segmentsWalk = 1.0f;  // the mean field's transmittance along the walk's segments so far
@@ -336,6 +399,9 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
       pdf = 1.0f;
       t1 = 0.0f;
       keep = 0u;
+#if PLUME_RS_CLASSES > 1
+      keepE = 0u;
+#endif
       kinds = 0u;
       slot = vec4(0.0f);
 #if PLUME_RS_LIGHT_CANDIDATES > 1
@@ -418,11 +484,11 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
   #ifdef PLUME_HAS_EMISSION
       if (j >= 2u) {  // the candidate ending with x_j's emission: sigma_a Le instead of scattering
         float ph = rs_weigh(D.k, fArrive * (vec3(1.0f) - vtx_albedo(VERTEX_MEDIUM)) * vol_emitted_radiance_world(VOL_CURRENT, x));
-        if (rs_update(r, invM * ph / pdf, ph, 0.0f, rng_float(rng))) {
-          head = rs_candidate_head(uv, t1, j, kinds, RS_LIGHT_EMISSION, vec2(0.0f), 0u);
-          keep = j;
+        if (rs_update(RS_E_R, invM * ph / pdf, ph, 0.0f, rng_float(rng))) {
+          RS_E_HEAD = rs_candidate_head(uv, t1, j, kinds, RS_LIGHT_EMISSION, vec2(0.0f), 0u);
+          RS_E_KEEP = j;
 #if PLUME_RS_LIGHT_CANDIDATES > 1
-          segmentsKeep = segmentsWalk;
+          RS_E_SEGMENTS = segmentsWalk;
 #endif
         }
       }
@@ -513,48 +579,24 @@ void rs_candidate_walks(uvec2 pixel, uint pixelIndex, uint outSet, uint first) {
       ++j;
     } else {
       for (uint i = 0u; i + 2u <= keep; ++i) rs_set_bounce(base + i, walk[i]);
+#if PLUME_RS_CLASSES > 1
+      for (uint i = 0u; i + 2u <= keepE; ++i) rs_set_bounce(baseE + i, walk[i]);
+#endif
       ++m;
       j = 0u;
     }
   }
   if (last < M) {
-#if PLUME_RS_LIGHT_CANDIDATES > 1
-    rs_set_state(rs_state_slot(pixelIndex), vec4(r.w_sum, r.p_hat, uintBitsToFloat(rng.counter), segmentsKeep));
-#else
-    rs_set_state(rs_state_slot(pixelIndex), vec4(r.w_sum, r.p_hat, uintBitsToFloat(rng.counter), 0.0f));
+    rs_candidates_pause(rs_state_slot(pixelIndex), setL, pixelIndex, r, head, rng.counter, segmentsKeep);
+#if PLUME_RS_CLASSES > 1
+    rs_candidates_pause(rs_state_slot(pixelIndex) + 1u, outSet, pixelIndex, rE, headE, rng.counter, segmentsKeepE);
 #endif
-    rs_store_head(outSet, pixelIndex, head);
     return;
   }
-  r.M = float(M);
-  rs_store_head(outSet, pixelIndex, head);
-#if PLUME_RS_LIGHT_CANDIDATES > 1
-  // The candidates' own target p̂' of light samples (above), so W = w_sum / p̂'(Y), p̂'(Y) the
-  // value rs_update kept for Y times the segments' transmittances that every weight left out
-  // (GRIS: any target of the candidates' own resampling that is positive wherever p̂ is gives an
-  // unbiased contribution weight). p̂' is the target without those transmittances (the light
-  // term with its visibility, the emitter hits' and the emission's terms alike), so the
-  // reservoir's p̂, the target of Y, is p̂'(Y) times them: gathered while the walk went
-  // (segmentsKeep: the same mean-field transmittance of the same rays as rs_path_contribution's),
-  // where until session 38 the target was evaluated once more from the stored path, tracing its
-  // rays again (the city's still frames -2.4 ms of 13; reuse reads this value as the input's own
-  // target, so the two must agree: GpuRestirSurfaces.CandidatesTargetIsTheTargetReuseEvaluates).
-  // 0 where Y's light ray is blocked (p̂' is), and then the reservoir holds no path.
-  float segments = segmentsKeep;
-  float target = head.vertexCount > 0u && r.w_sum > 0.0f ? r.p_hat * segments : 0.0f;
-  r.p_hat *= segments;
-  rs_finalize(r);
-  r.p_hat = target;
-  if (!(target > 0.0f)) r.W = 0.0f;
-#else
-#ifndef PLUME_RS_OUTSIDE
-  // The target of the selected path, with its transmittances (the weights' p̂ left them out).
-  r.p_hat = head.vertexCount > 0u && r.w_sum > 0.0f ? rs_target(D, outSet, pixelIndex) : 0.0f;
+  rs_candidates_finish(D, setL, pixelIndex, r, head, segmentsKeep, M);
+#if PLUME_RS_CLASSES > 1
+  rs_candidates_finish(D, outSet, pixelIndex, rE, headE, segmentsKeepE, M);
 #endif
-  rs_finalize(r);
-#endif
-  if (r.W <= 0.0f) rs_clear_path(outSet, pixelIndex);
-  rs_store(outSet, pixelIndex, r);
 }
 
 #endif

@@ -151,15 +151,18 @@ bool rs_tail_advance(inout RsTail s, inout RngState rng) {
 
 // Final shading's terms but the tail, drawn from `rng` (the pixel's shading stream).
 vec3 rs_shade(RsDomain D, uint pixelIndex, uint set, inout RngState rng) {
-  RsReservoir r = rs_load(set, pixelIndex);
   vec3 L = vec3(0.0f);
-  if (r.W > 0.0f) {
+  // Each class's reservoir (bridge.glsl PLUME_RS_CLASSES: set, set + RS_SETS), its estimate added.
+  for (uint c = 0u; c < uint(PLUME_RS_CLASSES); ++c) {
+    uint s = set + c * RS_SETS;
+    RsReservoir r = rs_load(s, pixelIndex);
+    if (!(r.W > 0.0f)) continue;
     // f without the segments' transmittances, whose target product is p̂ / lum(f) (the
     // reservoir's p̂ is the target of its path in this domain: candidates.glsl, reuse.glsl), and
     // the estimate of the fine transmittances' ratio to the target's (bridge.glsl).
     float est;
     float mis;
-    vec3 f = rs_path_contribution(D, set, pixelIndex, true, rng, est, mis);
+    vec3 f = rs_path_contribution(D, s, pixelIndex, true, rng, est, mis);
     float lum = rs_weigh(D.k, f);
     if (lum > 0.0f) L += (r.W * r.p_hat / lum) * est * mis * f;
   }

@@ -135,6 +135,7 @@ RenderSettings withRestir(RenderSettings rs, const RestirOptions& v) {
   rs.restirLightCandidatesMoving = v.lightCandidatesMoving;
   rs.restirShift = v.reconnect ? "reconnect" : "copy";
   rs.restirTarget = v.colourTarget ? "colour" : "luminance";
+  rs.restirEmissionReservoir = v.emissionReservoir ? "own" : "shared";
   return rs;
 }
 

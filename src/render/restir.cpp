@@ -25,7 +25,7 @@ std::string RestirOptions::name() const {
                         (historyCapStatic == RestirOptions{}.historyCapStatic ? "" : strf(" cs%d", historyCapStatic)) +
                         (candidatesMoving == RestirOptions{}.candidatesMoving ? "" : strf(" Mm%d", candidatesMoving)) +
                         (roundsStatic == RestirOptions{}.roundsStatic ? "" : strf(" Rs%d", roundsStatic)) +
-                        (reconnect ? "" : " copy") + (colourTarget ? "" : " lum") +
+                        (reconnect ? "" : " copy") + (colourTarget ? "" : " lum") + (emissionReservoir ? "" : " one") +
                         (fixedNeighbourX || fixedNeighbourY ? strf(" at(%d,%d)", fixedNeighbourX, fixedNeighbourY) : "");
   if (rounds == 0 && roundsStatic <= 0) return strf("restir %s M%d R0 c%d%s", kind, candidates, historyCap, k.c_str());
   return strf("restir %s M%d k%d r%d R%d c%d%s", kind, candidates, neighbours, radius, rounds, historyCap, k.c_str());
@@ -48,6 +48,7 @@ RestirOptions restirOptionsOf(const RenderSettings& rs) {
   o.lightCandidatesMoving = rs.restirLightCandidatesMoving;
   o.reconnect = rs.restirShift != "copy";
   o.colourTarget = rs.restirTarget != "luminance";
+  o.emissionReservoir = rs.restirEmissionReservoir != "shared";
   return o;
 }
 
@@ -130,6 +131,13 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   const int emitting = std::min({scene.render.maxBounces + 1, prefix + 1, int(shared::RS_MAX_VERTICES)});
   const bool tail = scene.render.maxBounces > prefix || (endsInEmission && scene.render.maxBounces + 1 > emitting);
   const int vertices = endsInEmission ? emitting : prefix;  // stored per path
+  // The paths that end in an emitting medium's emission in a reservoir of their own, beside those
+  // that end at a light (restir/bridge.glsl PLUME_RS_CLASSES), where both kinds exist: a pixel
+  // shades one path per reservoir, and one reservoir for both made its colour the colour of
+  // whichever end won (on the bundled fire half the error per frame: notes/restir.md "Session 40").
+  const bool lightPaths = !scene.lights.empty() || features_.emitters;
+  classes_ = options_.emissionReservoir && features_.emission && lightPaths ? 2u : 1u;
+  const size_t sets = size_t(kSets) * classes_;
   // Every per-pixel buffer below within the device's limits, checked before anything is compiled.
   // All but the accumulation (which the viewer's display reads) are storage texel buffers, whose
   // limit on lavapipe is 2^27 texels (2 GiB) where a storage buffer's is 128 MiB: at 1920x1080 the
@@ -141,7 +149,7 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
       shared::RS_STATE_SLOTS + shared::RS_COLOUR_SLOTS + (features_.emitters ? shared::RS_LAMP_SLOTS : 0);
   const size_t pixels = size_t(scene.camera.width) * size_t(scene.camera.height);
   const uint32_t stride = uint32_t(std::max(1, vertices - 1));  // vertex slots per pixel and set
-  const size_t vertexTexels = kSets * stride;                     // per pixel
+  const size_t vertexTexels = sets * stride;                      // per pixel
   {
     const VkPhysicalDeviceLimits& lim = ctx.limits();
     const bool texelsFit = pixels * vertexTexels <= lim.maxTexelBufferElements;
@@ -151,7 +159,7 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
     verticesInBuffer_ = options_.verticesInStorageBuffer || (!texelsFit && (bufferFits || bufferLarger));
     gpu::PerPixelBuffers perPixel;
     perPixel.storageBytes = {{"accumulation", 2 * sizeof(glm::vec4)}, {"pixel order", sizeof(uint32_t)}};
-    perPixel.texels = {{"reservoir paths and pass state", kSets * 2 + stateTexels}, {"reservoirs", kSets}};
+    perPixel.texels = {{"reservoir paths and pass state", sets * 2 + stateTexels}, {"reservoirs", sets}};
     if (verticesInBuffer_) {
       perPixel.storageBytes.push_back({"reservoir path vertices", vertexTexels * sizeof(glm::vec4)});
     } else {
@@ -207,6 +215,7 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
     d.emplace_back("PLUME_RS_RESIDUAL_SCALE", "16.0f");
     d.emplace_back("PLUME_RS_MIS", std::to_string(options_.mis) + "u");
     d.emplace_back("PLUME_RS_LIGHT_CANDIDATES", std::to_string(light > 0 ? light : lightCandidates));
+    d.emplace_back("PLUME_RS_CLASSES", std::to_string(classes_));
     // The reconnection shift only where there are surface vertices to reconnect to.
     if (features_.surfaces && options_.reconnect) d.emplace_back("PLUME_RS_RECONNECT", "1");
     if (verticesInBuffer_) d.emplace_back("PLUME_RS_VERTEX_BUFFER", "1");
@@ -275,16 +284,16 @@ Restir::Restir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& sc
   paramBuffer_ = gpu::Buffer(ctx, sizeof(shared::RestirParams) + (pixels + lampWords) * sizeof(uint32_t), storage,
                              "restir parameters");
   static_assert(sizeof(shared::RsPacked) == 16 && sizeof(shared::RsPathHead) == 32);  // 1 and 2 texels
-  reservoirs_ = gpu::TexelBuffer(ctx, nullptr, kSets * pixels, VK_FORMAT_R32G32B32A32_UINT, "reservoirs", true);
+  reservoirs_ = gpu::TexelBuffer(ctx, nullptr, sets * pixels, VK_FORMAT_R32G32B32A32_UINT, "reservoirs", true);
   // The path heads, then each pixel's state between the dispatches of a pass (the candidates'
   // running reservoir, the tail's walk: restir/bridge.glsl rs_state_slot), then with emissive
   // surfaces the lamp reservoirs (rs_lamp_slot).
-  paths_ = gpu::TexelBuffer(ctx, nullptr, (kSets * 2 + stateTexels) * pixels, VK_FORMAT_R32G32B32A32_UINT,
+  paths_ = gpu::TexelBuffer(ctx, nullptr, (sets * 2 + stateTexels) * pixels, VK_FORMAT_R32G32B32A32_UINT,
                             "reservoir paths and pass state", true);
   if (verticesInBuffer_) {
-    bounceBuffer_ = gpu::Buffer(ctx, kSets * pixels * stride * sizeof(glm::vec4), storage, "reservoir path vertices");
+    bounceBuffer_ = gpu::Buffer(ctx, sets * pixels * stride * sizeof(glm::vec4), storage, "reservoir path vertices");
   } else {
-    bounces_ = gpu::TexelBuffer(ctx, nullptr, kSets * pixels * stride, VK_FORMAT_R32G32B32A32_UINT,
+    bounces_ = gpu::TexelBuffer(ctx, nullptr, sets * pixels * stride, VK_FORMAT_R32G32B32A32_UINT,
                                 "reservoir path vertices", true);
   }
   output_ = gpu::Buffer(ctx, 2 * pixels * sizeof(glm::vec4), storage, "restir accumulation");
@@ -584,6 +593,19 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
       if (outside) over(*outside, push, inside, all - inside);
       timer_.end(cmd, scope);
     };
+    // A reuse pass over every class's reservoirs (class c of set s is set s + c * RS_SETS).
+    auto eachClass = [&](const gpu::ComputePass& walking, const gpu::ComputePass* outside, const char* label) {
+      const uint32_t scope = timer_.begin(cmd, label);
+      for (uint32_t c = 0; c < classes_; ++c) {
+        shared::RsPush p = push;
+        p.inSet += c * kSets;
+        p.historySet += c * kSets;
+        p.outSet += c * kSets;
+        over(walking, p, 0, outside ? inside : all);
+        if (outside) over(*outside, p, inside, all - inside);
+      }
+      timer_.end(cmd, scope);
+    };
     // walksPerDispatch candidate walks per dispatch (lavapipe's loop budget: restir/candidates.glsl);
     // the outside variant's M walks (none of them reaches a vertex) in one.
     if (colourUpdate_) {
@@ -633,9 +655,9 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
       const bool same = params_.historySameDomain != 0u && options_.sameDomainTemporal;
       // The same-domain pipeline evaluates no target: one dispatch over every pixel.
       if (same) {
-        both(*temporalSame_, nullptr, "restir temporal");
+        eachClass(*temporalSame_, nullptr, "restir temporal");
       } else {
-        both(*temporal_, temporalOut_.get(), "restir temporal");
+        eachClass(*temporal_, temporalOut_.get(), "restir temporal");
       }
       labels.push_back("temporal");
       gpu::computeBarrier(cmd);
@@ -647,7 +669,7 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
       push.historySet = cur;
       push.outSet = out;
       push.spatialRound = uint32_t(r);
-      both(*spatial_, spatialOut_.get(), "restir spatial");
+      eachClass(*spatial_, spatialOut_.get(), "restir spatial");
       labels.push_back(strf("spatial %d", r + 1));
       gpu::computeBarrier(cmd);
       cur = out;

@@ -48,6 +48,9 @@ struct RestirOptions {
                              // (false: the copy shift; shared/restir_types.h)
   bool colourTarget = true;  // each pixel's target weighs the channels by its estimated colour
                              // (restir/colour.glsl; false: the luminance)
+  bool emissionReservoir = true;  // with an emitting medium and lights, the paths that end in the
+                                  // medium's emission in a reservoir of their own (restir/bridge.glsl
+                                  // PLUME_RS_CLASSES; false: one reservoir for every path)
   // Tests only: the colour weights change every this many frames while the camera or the grid
   // moves (Restir::fillFrame); 1 makes every moving frame one whose history's domain keeps the
   // weights it had, which is what the Z-test must see often enough to resolve a mistake there.
@@ -102,6 +105,9 @@ class Restir {
          bool kernelCounters = false);
 
   const RestirOptions& options() const { return options_; }
+  // Reservoirs per pixel and set: 2 where an emitting medium's emission paths have their own
+  // (RestirOptions::emissionReservoir, with lights), else 1.
+  uint32_t classes() const { return classes_; }
   const FeatureSet& features() const { return features_; }
   // The volume of the frame about to be rendered and the previous frame's (temporal reuse
   // evaluates the history's target with it); pass the same volume twice for a still grid. Both
@@ -172,6 +178,9 @@ class Restir {
   std::unique_ptr<gpu::ComputePass> tail_;  // final shading's tail (null without one)
   uint32_t tailDispatches_ = 0;             // its dispatches per frame at most (max_bounces' walk)
   bool verticesInBuffer_ = false;           // the stored paths' vertices in a storage buffer (PLUME_RS_VERTEX_BUFFER)
+  // Reservoir classes (restir/bridge.glsl PLUME_RS_CLASSES): 2 where an emitting medium's emission
+  // paths have a reservoir of their own (class c of set s is set s + c * RS_SETS), else 1.
+  uint32_t classes_ = 1;
   gpu::GpuTimer timer_;
   gpu::TexelBuffer lightBuffer_;
   gpu::Buffer frameBuffer_, lightChoice_, paramBuffer_, output_, counters_;

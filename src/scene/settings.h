@@ -42,6 +42,7 @@ struct RenderSettings {
   int restirLightCandidatesMoving = 0;  // ... in frames whose camera moved (0: restirLightCandidates)
   std::string restirShift = "reconnect";  // reconnect (at the first surface vertex after the primary) | copy
   std::string restirTarget = "colour";    // colour (each pixel's channels weighed by its colour) | luminance
+  std::string restirEmissionReservoir = "own";  // own (an emitting medium's emission paths resampled apart) | shared
 };
 
 struct SettingDesc {
