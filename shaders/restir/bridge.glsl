@@ -16,8 +16,8 @@
 #define PLUME_RS_LIGHT_CANDIDATES 1  // light samples resampled at a candidate vertex (render/restir.cpp)
 #endif
 // Reservoirs per pixel and set: 1, or 2 where an emitting medium's paths that end in its emission
-// have a reservoir of their own (RS_CLASS_EMISSION, in set s) beside the paths that end at a light
-// (RS_CLASS_LIGHT, in set s + RS_SETS): render.restir_emission_reservoir, render/restir.cpp. The
+// have a reservoir of their own (class 0, in set s) beside the paths that end at a light or hit an
+// emitter (class 1, in set s + RS_SETS): render.restir_emission_reservoir, render/restir.cpp. The
 // two classes split the path space, so their estimates add; a pixel's one selected path no longer
 // carries the colour of whichever end won (the fire's orange emission against the sky's blue).
 #ifndef PLUME_RS_CLASSES

@@ -587,16 +587,12 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
       p.listCount = count;
       pass.record(cmd, glm::uvec3(count, 1, 1), &p);
     };
-    auto both = [&](const gpu::ComputePass& walking, const gpu::ComputePass* outside, const char* label) {
+    // `classes` > 1: once for each reservoir class, the sets offset (class c of set s is set
+    // s + c * RS_SETS): the reuse passes.
+    auto both = [&](const gpu::ComputePass& walking, const gpu::ComputePass* outside, const char* label,
+                    uint32_t classes = 1) {
       const uint32_t scope = timer_.begin(cmd, label);
-      over(walking, push, 0, outside ? inside : all);
-      if (outside) over(*outside, push, inside, all - inside);
-      timer_.end(cmd, scope);
-    };
-    // A reuse pass over every class's reservoirs (class c of set s is set s + c * RS_SETS).
-    auto eachClass = [&](const gpu::ComputePass& walking, const gpu::ComputePass* outside, const char* label) {
-      const uint32_t scope = timer_.begin(cmd, label);
-      for (uint32_t c = 0; c < classes_; ++c) {
+      for (uint32_t c = 0; c < classes; ++c) {
         shared::RsPush p = push;
         p.inSet += c * kSets;
         p.historySet += c * kSets;
@@ -655,9 +651,9 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
       const bool same = params_.historySameDomain != 0u && options_.sameDomainTemporal;
       // The same-domain pipeline evaluates no target: one dispatch over every pixel.
       if (same) {
-        eachClass(*temporalSame_, nullptr, "restir temporal");
+        both(*temporalSame_, nullptr, "restir temporal", classes_);
       } else {
-        eachClass(*temporal_, temporalOut_.get(), "restir temporal");
+        both(*temporal_, temporalOut_.get(), "restir temporal", classes_);
       }
       labels.push_back("temporal");
       gpu::computeBarrier(cmd);
@@ -669,7 +665,7 @@ void Restir::render(int frame, uint32_t sequence, uint32_t iteration, bool accum
       push.historySet = cur;
       push.outSet = out;
       push.spatialRound = uint32_t(r);
-      eachClass(*spatial_, spatialOut_.get(), "restir spatial");
+      both(*spatial_, spatialOut_.get(), "restir spatial", classes_);
       labels.push_back(strf("spatial %d", r + 1));
       gpu::computeBarrier(cmd);
       cur = out;
