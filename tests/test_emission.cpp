@@ -117,10 +117,11 @@ Scene emittingScene(glm::vec3 position, glm::vec3 lookAt, int size, float fovY) 
   return s;
 }
 
-Image reference(Scene s, openvdb::FloatGrid::Ptr density, openvdb::FloatGrid::Ptr emission, int spp) {
+Image reference(Scene s, openvdb::FloatGrid::Ptr density, openvdb::FloatGrid::Ptr emission, int spp, int frame = 1) {
   s.render.spp = spp;
   ref::ReferenceOptions opt;
   opt.progress = false;
+  opt.frame = frame;  // (the camera's pose of that frame)
   opt.emission = emission;
   return ref::renderReference(s, density, opt);
 }
@@ -280,9 +281,10 @@ Image restirMean(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& 
 }
 
 // `unresolved`: pixels left out of the per-pixel test (support/resolution.h; empty: none).
+// `refFrame`: the frame whose camera pose the reference renders (a moving camera's last frame).
 void compareRestir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene& scene, const RestirOptions& options,
                    int frames, int refSpp, const std::string& label, openvdb::FloatGrid::Ptr density = nullptr,
-                   openvdb::FloatGrid::Ptr emission = nullptr, std::vector<bool> unresolved = {}) {
+                   openvdb::FloatGrid::Ptr emission = nullptr, std::vector<bool> unresolved = {}, int refFrame = 1) {
   if (!density) density = test::makeNoiseGrid(40, 1.0 / 20, 3);
   if (!emission) emission = test::makeNoiseGrid(40, 1.0 / 20, 8);
   test::ReferenceCheckOptions opt;
@@ -292,7 +294,7 @@ void compareRestir(gpu::Context& ctx, gpu::ShaderCompiler& compiler, const Scene
   uint32_t dropped = 0;
   Image img = restirMean(ctx, compiler, scene, options, density, emission, 256, frames, meanVariance, dropped);
   opt.imageMeanVariance = meanVariance;
-  test::expectMatchesReference(img, reference(scene, density, emission, refSpp), label, opt);
+  test::expectMatchesReference(img, reference(scene, density, emission, refSpp, refFrame), label, opt);
   EXPECT_EQ(dropped, 0u) << label;
 }
 
@@ -377,6 +379,22 @@ TEST_F(GpuEmission, RestirEmissionReservoirOfItsOwnMatchesReference) {
     EXPECT_EQ(Restir(ctx(), compiler(), dark, o).classes(), 1u);
   }
   compareRestir(ctx(), compiler(), s, o, 3, 4096, "restir_emission_reservoir");
+}
+
+// The same classes under a moving camera: four frames whose camera moves to a new pose by the
+// last one (every frame's temporal reuse shifts each class's history from the previous pose by
+// the general pipeline), against the reference of that pose.
+TEST_F(GpuEmission, RestirEmissionReservoirMovingCameraMatchesReferenceOfItsLastPose) {
+  Scene s = restirCloud(true);
+  s.lights.push_back(test::skyLight({0.05f, 0.12f, 0.35f}));
+  CameraKey key;
+  key.frame = 4;
+  key.pose = s.camera.base;
+  key.pose.position = {1.5f, 1.4f, 3.4f};
+  s.camera.keys.push_back(key);
+  RestirOptions o;
+  o.radius = 6;
+  compareRestir(ctx(), compiler(), s, o, 4, 4096, "restir_emission_reservoir_moving", nullptr, nullptr, {}, 4);
 }
 
 }  // namespace
