@@ -37,7 +37,8 @@ RestirParams rsp;  // a private copy (volume/bindings.glsl says why), loaded by 
 layout(rgba32ui, binding = BIND_RS_RESERVOIRS) uniform uimageBuffer rsReservoirTexels;
 // Path heads as stored: two texels per RsPathHead (its C++ layout), texels 2 * (set * pixels +
 // pixel) and the next, loaded and stored whole by rs_load_head / rs_store_head (restir/bridge.glsl);
-// past the RS_SETS sets' heads, the passes' state between dispatches (bridge.glsl rs_state_slot).
+// past the RS_ALL_SETS sets' heads (RS_SETS per reservoir class, bridge.glsl), the passes' state
+// between dispatches (bridge.glsl rs_state_slot).
 layout(rgba32ui, binding = BIND_RS_PATHS) uniform uimageBuffer rsPathTexels;
 uvec4 rs_path_word(uint i) { return imageLoad(rsPathTexels, int(i)); }
 void rs_set_path_word(uint i, uvec4 v) { imageStore(rsPathTexels, int(i), v); }

@@ -1,6 +1,7 @@
 // Volumetric ReSTIR on the GPU (DESIGN §4.2): per frame, candidates -> temporal reuse ->
 // spatial reuse x R -> final shading (-> its tail), compute passes (shaders/passes/restir_*.comp)
-// over three reservoir sets that rotate (the last frame's final set is the history). Candidates
+// over three reservoir sets that rotate (the last frame's final set is the history; three more
+// where an emitting medium's emission paths have their own reservoir class). Candidates
 // and the tail are dispatched several times, each dispatch a bounded share of the work
 // (lavapipe's loop budget: notes/restir.md "Bounded work per dispatch"). The host only
 // fills parameter blocks and picks sets; all reservoir arithmetic lives in the shaders
